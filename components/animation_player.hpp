@@ -1,0 +1,40 @@
+// Plays an animation clip on a character's skeleton (method §1.1).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// Key frames of one bone. Times in seconds, ascending.
+struct BoneChannel {
+    int bone = -1;
+    std::vector<float> position_times_s;
+    std::vector<Vec3> positions;
+    std::vector<float> rotation_times_s;
+    std::vector<Quat> rotations;
+    std::vector<float> scale_times_s;
+    std::vector<Vec3> scales;
+};
+
+/// Immutable clip shared by every player.
+struct AnimationClip {
+    std::string name;
+    double duration_s = 0;
+    std::vector<BoneChannel> channels;
+};
+
+/// Per-instance playback state.
+struct AnimationPlayer {
+    std::shared_ptr<const AnimationClip> clip;
+    double time_s = 0;
+    double speed = 1;           ///< Playback rate multiplier.
+    bool loop = true;
+    bool in_place = true;       ///< true: the root's horizontal travel is removed; false: it moves the Transform (root motion).
+    bool playing = true;
+};
+
+}  // namespace drape

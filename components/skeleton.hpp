@@ -1,0 +1,36 @@
+// A character's bones: shared hierarchy and bind pose, per-instance pose (method §1.1).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// Immutable skeleton data shared by every instance of a character.
+struct SkeletonAsset {
+    std::vector<std::string> bone_names;
+    std::vector<int> parents;            ///< -1 for a root; parents[i] < i (sorted parent first).
+    std::vector<Affine3> rest_local;     ///< Node pose: bone -> parent, metres, Y up.
+    std::vector<Affine3> inverse_bind;   ///< Model space at bind -> bone space (skinning).
+
+    [[nodiscard]] std::size_t size() const noexcept { return parents.size(); }
+    /// Index of a bone by name, -1 when absent.
+    [[nodiscard]] int find(std::string_view name) const noexcept {
+        for (std::size_t i = 0; i < bone_names.size(); ++i)
+            if (bone_names[i] == name) return static_cast<int>(i);
+        return -1;
+    }
+};
+
+/// Per-instance pose. Written by the animation system.
+struct Skeleton {
+    std::shared_ptr<const SkeletonAsset> asset;
+    std::vector<Affine3> local;      ///< Current bone -> parent.
+    std::vector<Affine3> global;     ///< Current bone -> model space.
+    std::vector<Affine3> skinning;   ///< global * inverse_bind: bind model space -> current model space.
+};
+
+}  // namespace drape

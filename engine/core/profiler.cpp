@@ -1,0 +1,154 @@
+#include "engine/core/profiler.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+
+namespace drape {
+
+namespace {
+constexpr std::uint32_t frame_slot = std::numeric_limits<std::uint32_t>::max();
+
+double percentile(std::vector<float> values, double q) {
+    if (values.empty()) return 0;
+    const auto k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5);
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+    return values[k];
+}
+
+std::string json_escape(std::string_view s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '"' || c == '\\') { out += '\\'; out += c; }
+        else if (static_cast<unsigned char>(c) < 0x20) { char buf[8]; std::snprintf(buf, sizeof buf, "\\u%04x", c); out += buf; }
+        else out += c;
+    }
+    return out;
+}
+}  // namespace
+
+FrameProfiler::FrameProfiler(std::size_t ring_capacity) : m_capacity(std::max<std::size_t>(ring_capacity, 16)) {}
+
+std::uint32_t FrameProfiler::add_slot(std::string name) {
+    Slot slot;
+    slot.name = std::move(name);
+    slot.recent_ms.reserve(m_capacity);
+    m_slots.push_back(std::move(slot));
+    return static_cast<std::uint32_t>(m_slots.size() - 1);
+}
+
+void FrameProfiler::begin_frame() noexcept {
+    if (m_timing) m_frame_start = Clock::now();
+}
+
+void FrameProfiler::end_frame() noexcept {
+    ++m_frames;
+    if (!m_timing) return;
+    const auto end = Clock::now();
+    m_frame_total_ms += std::chrono::duration<double, std::milli>(end - m_frame_start).count();
+    push_event(frame_slot, m_frame_start, end);
+}
+
+void FrameProfiler::record_run(std::uint32_t slot, Clock::time_point start, Clock::time_point end) noexcept {
+    Slot& s = m_slots[slot];
+    const double ms = std::chrono::duration<double, std::milli>(end - start).count();
+    ++s.runs;
+    s.total_ms += ms;
+    s.max_ms = std::max(s.max_ms, ms);
+    if (s.recent_ms.size() < m_capacity) s.recent_ms.push_back(static_cast<float>(ms));
+    else s.recent_ms[s.next] = static_cast<float>(ms);
+    s.next = (s.next + 1) % m_capacity;
+    push_event(slot, start, end);
+}
+
+void FrameProfiler::push_event(std::uint32_t slot, Clock::time_point start, Clock::time_point end) noexcept {
+    TraceEvent ev{slot,
+                  std::chrono::duration_cast<std::chrono::microseconds>(start - m_origin).count(),
+                  std::chrono::duration_cast<std::chrono::microseconds>(end - start).count()};
+    if (m_events.size() < m_capacity) m_events.push_back(ev);
+    else m_events[m_next_event] = ev;
+    m_next_event = (m_next_event + 1) % m_capacity;
+}
+
+double FrameProfiler::mean_frame_ms() const noexcept {
+    return m_frames ? m_frame_total_ms / static_cast<double>(m_frames) : 0;
+}
+
+std::vector<SystemStats> FrameProfiler::stats() const {
+    std::vector<SystemStats> out;
+    out.reserve(m_slots.size());
+    for (const Slot& s : m_slots) {
+        SystemStats st;
+        st.name = s.name;
+        st.runs = s.runs;
+        st.skips = s.skips;
+        st.total_ms = s.total_ms;
+        st.max_ms = s.max_ms;
+        st.mean_ms = s.recent_ms.empty() ? 0 : s.total_ms / static_cast<double>(s.runs);
+        st.p50_ms = percentile(s.recent_ms, 0.50);
+        st.p95_ms = percentile(s.recent_ms, 0.95);
+        st.share = m_frame_total_ms > 0 ? s.total_ms / m_frame_total_ms : 0;
+        out.push_back(std::move(st));
+    }
+    return out;
+}
+
+SystemStats FrameProfiler::stats(std::string_view name) const {
+    for (SystemStats& s : stats())
+        if (s.name == name) return s;
+    return SystemStats{std::string(name)};
+}
+
+std::string FrameProfiler::table() const {
+    std::string out;
+    char line[256];
+    std::snprintf(line, sizeof line, "Frame budget over %llu frames (mean frame %.3f ms)\n",
+                  static_cast<unsigned long long>(m_frames), mean_frame_ms());
+    out += line;
+    std::snprintf(line, sizeof line, "%-28s %8s %8s %9s %9s %9s %9s %7s\n", "system", "runs", "skips",
+                  "mean ms", "p50 ms", "p95 ms", "max ms", "share");
+    out += line;
+    for (const SystemStats& s : stats()) {
+        std::snprintf(line, sizeof line, "%-28s %8llu %8llu %9.4f %9.4f %9.4f %9.4f %6.1f%%\n", s.name.c_str(),
+                      static_cast<unsigned long long>(s.runs), static_cast<unsigned long long>(s.skips), s.mean_ms,
+                      s.p50_ms, s.p95_ms, s.max_ms, 100.0 * s.share);
+        out += line;
+    }
+    return out;
+}
+
+Result<void> FrameProfiler::write_trace(const std::filesystem::path& file) const {
+    std::ofstream os(file, std::ios::binary | std::ios::trunc);
+    if (!os) return fail(file.string() + ": cannot open the trace file for writing");
+    os << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[";
+    // Oldest first: the ring's order starts at m_next_event once it has wrapped.
+    const std::size_t n = m_events.size();
+    const std::size_t first = n < m_capacity ? 0 : m_next_event;
+    for (std::size_t k = 0; k < n; ++k) {
+        const TraceEvent& ev = m_events[(first + k) % n];
+        const bool is_frame = ev.slot == frame_slot;
+        os << (k ? ",\n" : "\n") << "{\"name\":\""
+           << (is_frame ? std::string("frame") : json_escape(m_slots[ev.slot].name))
+           << "\",\"cat\":\"" << (is_frame ? "frame" : "system") << "\",\"ph\":\"X\",\"ts\":" << ev.start_us
+           << ",\"dur\":" << ev.duration_us << ",\"pid\":1,\"tid\":" << (is_frame ? 1 : 2) << "}";
+    }
+    os << "\n]}\n";
+    if (!os) return fail(file.string() + ": write failed");
+    return {};
+}
+
+void FrameProfiler::reset() noexcept {
+    for (Slot& s : m_slots) {
+        s.runs = s.skips = 0;
+        s.total_ms = s.max_ms = 0;
+        s.recent_ms.clear();
+        s.next = 0;
+    }
+    m_events.clear();
+    m_next_event = 0;
+    m_frames = 0;
+    m_frame_total_ms = 0;
+}
+
+}  // namespace drape

@@ -1,0 +1,21 @@
+// Subcommands of the `drape` command. Each lives in its own file and adds itself to the
+// command line; main() runs the one the user chose.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace drape {
+
+/// `drape play`: runs a scene (the sample scene by default) and prints the frame budget.
+void add_play_command(CLI::App& app);
+
+/// `drape inspect FILE`: what a character file holds.
+void add_inspect_command(CLI::App& app);
+
+/// `drape bench NAME`: benchmarks and reports (bench/).
+void add_bench_command(CLI::App& app);
+
+/// Exit code of the subcommand that ran (set by its callback).
+int& command_exit_code();
+
+}  // namespace drape

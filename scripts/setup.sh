@@ -1,0 +1,54 @@
+# Shared by scripts/play and scripts/test: install what is missing, configure, build.
+# Sourced, not run. Honours DRAPE_BUILD_DIR (default: build) and DRAPE_CMAKE_ARGS.
+
+set -euo pipefail
+
+DRAPE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+DRAPE_BUILD_DIR=${DRAPE_BUILD_DIR:-"$DRAPE_ROOT/build"}
+
+# Debian packages Drape builds, tests and benchmarks with.
+DRAPE_PACKAGES=(
+  build-essential cmake pkg-config git
+  libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libstb-dev
+  libgtest-dev libgmock-dev googletest libbenchmark-dev
+  libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
+  libbullet-dev ffmpeg gnuplot-nox xvfb xauth
+)
+
+drape_log() { printf 'drape: %s\n' "$*" >&2; }
+
+# Installs the packages that are missing; reinstalls nothing.
+drape_install_packages() {
+  local missing=()
+  local pkg
+  for pkg in "$@"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$pkg")
+    fi
+  done
+  if [ ${#missing[@]} -eq 0 ]; then
+    return 0
+  fi
+  drape_log "installing missing Debian packages: ${missing[*]}"
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then
+      sudo=(sudo)
+    else
+      drape_log "error: not root and no sudo; install these packages first: ${missing[*]}"
+      return 1
+    fi
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+# Configures (once) and builds incrementally in $DRAPE_BUILD_DIR, Release.
+drape_build() {
+  local extra=(${DRAPE_CMAKE_ARGS:-})
+  if [ ! -f "$DRAPE_BUILD_DIR/CMakeCache.txt" ] || [ ${#extra[@]} -gt 0 ]; then
+    cmake -S "$DRAPE_ROOT" -B "$DRAPE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${extra[@]}" "$@" >/dev/null
+  fi
+  cmake --build "$DRAPE_BUILD_DIR" --parallel "$(nproc)"
+}
