@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <unordered_map>
@@ -252,7 +253,18 @@ public:
     }
 
     [[noreturn]] void fail_at(const std::string& path, std::string_view reason, bool at_key = false) const {
-        throw SceneError{located(where(path, at_key), path, reason)};
+        // A key may hold any character: keep the message on one printable line.
+        std::string field;
+        for (const char c : path) {
+            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+                char escaped[8];
+                std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned char>(c));
+                field += escaped;
+            } else {
+                field += c;
+            }
+        }
+        throw SceneError{located(where(path, at_key), field, reason)};
     }
 
     [[nodiscard]] const std::filesystem::path& base_dir() const { return m_base; }
@@ -576,6 +588,19 @@ Result<SceneDescription> parse_scene(std::string_view text, std::string_view lab
         const auto [line, column] = line_column(text, e.byte > 0 ? e.byte - 1 : 0);
         const SourceLocation where = name.empty() ? SourceLocation{} : SourceLocation{name, line, column};
         return fail(located(where, "", parse_error_reason(e)));
+    } catch (const Json::exception& e) {
+        // Number overflow ("1e400") carries no position: find the literal it quotes.
+        const std::string what = e.what();
+        std::size_t offset = 0;
+        if (const std::size_t open = what.find(" '"); open != std::string::npos)
+            if (const std::size_t close = what.find('\'', open + 2); close != std::string::npos)
+                if (const std::size_t at = text.find(std::string_view(what).substr(open + 2, close - open - 2)); at != std::string_view::npos)
+                    offset = at;
+        const auto [line, column] = line_column(text, offset);
+        const SourceLocation where = name.empty() ? SourceLocation{} : SourceLocation{name, line, column};
+        const std::size_t bracket = what.find("] ");
+        return fail(located(where, "", (bracket == std::string::npos ? what : what.substr(bracket + 2)) +
+                                           " (numbers must be finite and fit a double)"));
     }
     Positions positions;
     if (auto problem = PositionScanner(text).scan(positions)) {
