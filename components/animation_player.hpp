@@ -25,6 +25,11 @@ struct AnimationClip {
     std::string name;
     double duration_s = 0;
     std::vector<BoneChannel> channels;
+    /// The bone that carries the clip's travel (the shallowest bone with translation keys),
+    /// -1 when none. Playing in place removes `travel_m` from it, spread linearly over the clip.
+    int motion_bone = -1;
+    Vec3 travel_m = Vec3::Zero();   ///< Horizontal model-space travel of `motion_bone` over one cycle.
+    Vec3 travel_local = Vec3::Zero();  ///< The same in the motion bone's parent space.
 };
 
 /// Per-instance playback state.
@@ -35,6 +40,7 @@ struct AnimationPlayer {
     bool loop = true;
     bool in_place = true;       ///< true: the root's horizontal travel is removed; false: it moves the Transform (root motion).
     bool playing = true;
+    int cycles = 0;             ///< Completed loops (root motion advances the Transform once per loop).
 };
 
 }  // namespace drape

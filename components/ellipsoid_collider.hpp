@@ -1,11 +1,35 @@
 // One ellipsoid bound to a skeleton bone (method §2, §5): a unit sphere scaled by `radii`,
 // rotated and placed in bone space; it follows its bone.
+//
+// "Bone space" here is the bone's frame with any scale removed (its position and
+// orientation only), so centres and radii are in metres even when a file's armature
+// carries a scale: world = Transform * rigid(bone global) * translate(center) *
+// rotate(rotation) * scale(radii_m).
 #pragma once
+
+#include <cstdint>
+#include <string>
 
 #include "engine/core/math.hpp"
 #include "engine/core/registry.hpp"
 
 namespace drape {
+
+/// The part of a body an ellipsoid covers, guessed from bone names (the skirt builder
+/// looks for `pelvis`, a shirt for `torso` and the arms).
+enum class BodyRegion : std::uint8_t {
+    other, head, neck, torso, pelvis, upper_arm, lower_arm, hand, upper_leg, lower_leg, foot,
+};
+[[nodiscard]] const char* body_region_name(BodyRegion region) noexcept;
+
+/// An ellipsoid in bone space: what fitting produces and a scene file may override.
+struct EllipsoidShape {
+    int bone = -1;                     ///< Index into SkeletonAsset.
+    Vec3 center = Vec3::Zero();        ///< m, bone space.
+    Quat rotation = Quat::Identity();  ///< Bone space -> ellipsoid axes.
+    Vec3 radii_m = Vec3::Constant(0.1f);
+    BodyRegion region = BodyRegion::other;
+};
 
 struct EllipsoidCollider {
     // Authored or fitted, in the bone's space (metres).
@@ -14,6 +38,7 @@ struct EllipsoidCollider {
     Vec3 center = Vec3::Zero();
     Quat rotation = Quat::Identity();
     Vec3 radii_m = Vec3::Constant(0.1f);
+    BodyRegion region = BodyRegion::other;
 
     // World state, written by the collider system once per fixed step.
     Affine3 world = Affine3::Identity();           ///< Unit sphere -> world (translation * rotation * scale).

@@ -15,6 +15,11 @@ struct SkeletonAsset {
     std::vector<int> parents;            ///< -1 for a root; parents[i] < i (sorted parent first).
     std::vector<Affine3> rest_local;     ///< Node pose: bone -> parent, metres, Y up.
     std::vector<Affine3> inverse_bind;   ///< Model space at bind -> bone space (skinning).
+    // rest_local split into translation, rotation and scale: what a bone keeps for the
+    // parts a clip does not animate.
+    std::vector<Vec3> rest_translation;
+    std::vector<Quat> rest_rotation;
+    std::vector<Vec3> rest_scale;
 
     [[nodiscard]] std::size_t size() const noexcept { return parents.size(); }
     /// Index of a bone by name, -1 when absent.

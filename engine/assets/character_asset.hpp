@@ -1,0 +1,53 @@
+// What importing a character produces: immutable data shared by every instance.
+//
+// Conventions after import (method §1, §2): metres, Y up, model space = the file's scene
+// root after the unit and axis correction; every vertex has at most 4 bone influences
+// whose weights sum to 1; clip times in seconds.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "components/animation_player.hpp"
+#include "components/ellipsoid_collider.hpp"
+#include "components/skeleton.hpp"
+#include "components/skinned_mesh.hpp"
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// How the importer chose the file's unit scale.
+enum class ScaleSource : std::uint8_t {
+    option,     ///< ImportOptions::scale.
+    height,     ///< ImportOptions::height_m.
+    file_units, ///< The file's unit metadata (FBX UnitScaleFactor, COLLADA <unit>, glTF = metres).
+    fallback,   ///< File units gave an implausible height; scaled to ImportOptions::fallback_height_m.
+};
+[[nodiscard]] const char* scale_source_name(ScaleSource source) noexcept;
+
+/// One mesh of the file as it ended up in the merged MeshAsset.
+struct MeshInfo {
+    std::string name;
+    std::uint32_t first_vertex = 0;
+    std::uint32_t vertex_count = 0;
+    bool rigid = false;   ///< Had no skin: bound with weight 1 to the bone it hangs from.
+};
+
+struct CharacterAsset {
+    std::filesystem::path source;
+    std::string name;                                   ///< File stem.
+    std::shared_ptr<const SkeletonAsset> skeleton;
+    std::shared_ptr<const MeshAsset> mesh;               ///< All meshes of the file, merged.
+    std::vector<std::shared_ptr<const AnimationClip>> clips;
+    std::vector<EllipsoidShape> ellipsoids;             ///< Fitted, bone space: bone, center, rotation, radii_m.
+    std::vector<MeshInfo> meshes;
+    Real height_m = 0;                                  ///< Vertical extent of the rest pose.
+    double scale = 1;                                   ///< File units -> metres that was applied.
+    ScaleSource scale_source = ScaleSource::file_units;
+    int skin_bones = 0;                                 ///< Bones that move at least one vertex.
+    int hip_bone = -1;                                  ///< find_hip_bone(); -1 when none.
+};
+
+}  // namespace drape

@@ -1,0 +1,58 @@
+// Character import through assimp: glTF 2.0 (.glb/.gltf), FBX, COLLADA, and BVH motion.
+//
+// Normalisation (method §1, §2): metres (ImportOptions::scale, else ImportOptions::height_m,
+// else the file's unit metadata, falling back to a standard height when the file's units
+// give an implausible one), Y up (FBX axis metadata; COLLADA's up axis is applied by assimp),
+// at most 4 weights per vertex summing to 1, clip times in seconds (assimp reports glTF
+// times in milliseconds through mTicksPerSecond), all meshes merged into one MeshAsset with
+// one submesh each. Meshes parented rigidly to a bone become skinned vertices with weight
+// 1 on it. Skinning uses the file's inverse bind matrices, which may differ from its node
+// pose (the bind pose is kept, the node pose is the rest pose).
+//
+// Every failure is one line naming the file and the reason.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string_view>
+
+#include "engine/assets/character_asset.hpp"
+#include "engine/core/error.hpp"
+#include "systems/character/ellipsoid_fit.hpp"
+
+namespace drape {
+
+struct ImportOptions {
+    std::optional<double> scale;        ///< File units -> metres; overrides everything else.
+    std::optional<double> height_m;     ///< Scale the rest pose to this height.
+    double fallback_height_m = 1.75;    ///< Used when the file's units give a height outside the plausible range.
+    double min_plausible_height_m = 0.3;
+    double max_plausible_height_m = 2.6;
+    bool require_animation = true;      ///< A file without clips is an error (set false to add BVH clips later).
+    bool fit_ellipsoids = true;
+    FitOptions fit;
+};
+
+/// Checks the options; the error names the field.
+[[nodiscard]] Result<void> validate(const ImportOptions& options);
+
+/// Imports a character file.
+[[nodiscard]] Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesystem::path& path,
+                                                                             const ImportOptions& options = {});
+
+/// Imports the motion of a BVH file onto a skeleton whose bone names match the BVH joints
+/// (every joint must exist with the same parent). Root translation is rescaled from the
+/// BVH's units by comparing bone lengths.
+[[nodiscard]] Result<std::shared_ptr<const AnimationClip>> import_bvh_motion(const std::filesystem::path& path,
+                                                                             const SkeletonAsset& skeleton);
+
+/// A clip by exact name, else by index ("0", "3"). The error lists the clips there are.
+[[nodiscard]] Result<std::size_t> find_clip(const CharacterAsset& character, std::string_view name_or_index);
+
+/// The clip's motion bone and travel (AnimationClip::motion_bone, travel_m, travel_local)
+/// from its keys and the skeleton's rest pose.
+void compute_clip_travel(AnimationClip& clip, const SkeletonAsset& skeleton);
+
+}  // namespace drape

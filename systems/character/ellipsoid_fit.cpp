@@ -1,0 +1,381 @@
+// Ellipsoid fitting and coverage (method §2). See ellipsoid_fit.hpp.
+#include "systems/character/ellipsoid_fit.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "systems/character/pose.hpp"
+
+namespace drape {
+
+const char* body_region_name(BodyRegion region) noexcept {
+    switch (region) {
+        case BodyRegion::other: return "other";
+        case BodyRegion::head: return "head";
+        case BodyRegion::neck: return "neck";
+        case BodyRegion::torso: return "torso";
+        case BodyRegion::pelvis: return "pelvis";
+        case BodyRegion::upper_arm: return "upper_arm";
+        case BodyRegion::lower_arm: return "lower_arm";
+        case BodyRegion::hand: return "hand";
+        case BodyRegion::upper_leg: return "upper_leg";
+        case BodyRegion::lower_leg: return "lower_leg";
+        case BodyRegion::foot: return "foot";
+    }
+    return "other";
+}
+
+namespace {
+
+std::string lower(std::string_view s) {
+    std::string out(s);
+    std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (const auto colon = out.rfind(':'); colon != std::string::npos) out.erase(0, colon + 1);  // "mixamorig:Hips"
+    return out;
+}
+
+bool has_any(const std::string& s, std::initializer_list<std::string_view> words) {
+    for (std::string_view w : words)
+        if (s.find(w) != std::string::npos) return true;
+    return false;
+}
+
+std::optional<BodyRegion> region_from_string(std::string_view s) {
+    for (int r = 0; r <= static_cast<int>(BodyRegion::foot); ++r)
+        if (s == body_region_name(static_cast<BodyRegion>(r))) return static_cast<BodyRegion>(r);
+    return std::nullopt;
+}
+
+// Points on the unit sphere, evenly spread (Fibonacci lattice).
+Matrix3X sphere_samples(int n) {
+    Matrix3X out(3, n);
+    const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < n; ++i) {
+        const double y = 1.0 - 2.0 * (i + 0.5) / n;
+        const double r = std::sqrt(std::max(0.0, 1.0 - y * y));
+        out.col(i) = Vec3(static_cast<Real>(r * std::cos(golden * i)), static_cast<Real>(y),
+                          static_cast<Real>(r * std::sin(golden * i)));
+    }
+    return out;
+}
+
+}  // namespace
+
+Result<void> validate(const FitOptions& o) {
+    if (!(o.min_cluster_fraction >= 0 && o.min_cluster_fraction < 1)) return fail("fit.min_cluster_fraction: must be in [0, 1)");
+    if (!(o.min_cluster_size >= 0 && o.min_cluster_size < 1)) return fail("fit.min_cluster_size: must be in [0, 1)");
+    if (!(o.cluster_coverage > 0 && o.cluster_coverage <= 1)) return fail("fit.cluster_coverage: must be in (0, 1]");
+    if (!(o.min_radius_m > 0 && std::isfinite(o.min_radius_m))) return fail("fit.min_radius_m: must be > 0");
+    return {};
+}
+
+BodyRegion region_from_bone_name(std::string_view name) noexcept {
+    const std::string s = lower(name);
+    if (has_any(s, {"hips", "pelvis"})) return BodyRegion::pelvis;
+    if (has_any(s, {"hand", "palm", "finger", "thumb", "index", "middle", "ring", "pinky", "wrist"})) return BodyRegion::hand;
+    if (has_any(s, {"forearm", "lowerarm", "lower_arm", "lowarm", "elbow"})) return BodyRegion::lower_arm;
+    if (has_any(s, {"upperarm", "upper_arm", "uparm", "arm"})) return BodyRegion::upper_arm;
+    if (has_any(s, {"foot", "toe", "ankle"})) return BodyRegion::foot;
+    if (has_any(s, {"upleg", "upperleg", "upper_leg", "thigh"})) return BodyRegion::upper_leg;
+    if (has_any(s, {"lowerleg", "lower_leg", "shin", "calf", "knee", "leg"})) return BodyRegion::lower_leg;
+    if (has_any(s, {"neck"})) return BodyRegion::neck;
+    if (has_any(s, {"head"})) return BodyRegion::head;
+    if (has_any(s, {"spine", "chest", "torso", "abdomen", "belly", "waist", "shoulder", "clavicle"})) return BodyRegion::torso;
+    return BodyRegion::other;
+}
+
+int find_hip_bone(const SkeletonAsset& skeleton) {
+    for (std::size_t i = 0; i < skeleton.size(); ++i)
+        if (region_from_bone_name(skeleton.bone_names[i]) == BodyRegion::pelvis) return static_cast<int>(i);
+    // The deepest common ancestor of the upper legs.
+    std::vector<int> legs;
+    for (std::size_t i = 0; i < skeleton.size(); ++i)
+        if (region_from_bone_name(skeleton.bone_names[i]) == BodyRegion::upper_leg) legs.push_back(static_cast<int>(i));
+    if (legs.size() < 2) return -1;
+    auto ancestors = [&](int b) {
+        std::vector<int> out;
+        for (int p = skeleton.parents[static_cast<std::size_t>(b)]; p >= 0; p = skeleton.parents[static_cast<std::size_t>(p)])
+            out.push_back(p);
+        return out;
+    };
+    const std::vector<int> a = ancestors(legs[0]);
+    const std::vector<int> other = ancestors(legs[1]);
+    for (int candidate : a)
+        if (std::find(other.begin(), other.end(), candidate) != other.end()) return candidate;
+    return -1;
+}
+
+std::vector<int> dominant_bones(const MeshAsset& mesh) {
+    std::vector<int> out(mesh.vertex_count(), 0);
+    for (Eigen::Index j = 0; j < mesh.bone_weights.cols(); ++j) {
+        Eigen::Index k = 0;
+        mesh.bone_weights.col(j).maxCoeff(&k);
+        out[static_cast<std::size_t>(j)] = mesh.bone_indices(k, j);
+    }
+    return out;
+}
+
+std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
+                                           const FitOptions& options) {
+    const std::size_t bones = skeleton.size();
+    const std::size_t n = mesh.vertex_count();
+    std::vector<std::vector<Eigen::Index>> clusters(bones);
+    const std::vector<int> dominant = dominant_bones(mesh);
+    for (std::size_t j = 0; j < n; ++j) clusters[static_cast<std::size_t>(dominant[j])].push_back(static_cast<Eigen::Index>(j));
+
+    // Bone frames at bind (rigid: metres), model space.
+    std::vector<Affine3> frame(bones);
+    for (std::size_t b = 0; b < bones; ++b) frame[b] = rigid_part(skeleton.inverse_bind[b].inverse());
+
+    // Small clusters hand their vertices to the parent; children are visited first.
+    const int hip = find_hip_bone(skeleton);
+    std::vector<bool> holds_hip(bones, false);  // the cluster took in the hip bone's vertices
+    if (hip >= 0) holds_hip[static_cast<std::size_t>(hip)] = true;
+    const auto min_count = static_cast<std::size_t>(std::ceil(options.min_cluster_fraction * double(n)));
+    const Real min_size = static_cast<Real>(options.min_cluster_size) * height_m;
+    for (std::size_t b = bones; b-- > 0;) {
+        auto& c = clusters[b];
+        if (c.empty()) continue;
+        Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::max()), hi = -lo;
+        for (Eigen::Index j : c) {
+            lo = lo.cwiseMin(mesh.bind_positions.col(j));
+            hi = hi.cwiseMax(mesh.bind_positions.col(j));
+        }
+        const bool small = c.size() < std::max<std::size_t>(min_count, 4) || (hi - lo).norm() < min_size;
+        if (!small) continue;
+        const int parent = skeleton.parents[b];
+        if (parent >= 0) {
+            auto& target = clusters[static_cast<std::size_t>(parent)];
+            target.insert(target.end(), c.begin(), c.end());
+            if (holds_hip[b]) holds_hip[static_cast<std::size_t>(parent)] = true;
+        }
+        c.clear();
+    }
+
+    // A hand or a foot gets one ellipsoid: its clusters join the topmost bone of the same
+    // region above them, and sibling clusters of that region (separate palm bones) join
+    // the first of them.
+    auto region_of = [&](std::size_t b) { return region_from_bone_name(skeleton.bone_names[b]); };
+    auto extremity = [](BodyRegion r) { return r == BodyRegion::hand || r == BodyRegion::foot; };
+    auto move = [&](std::size_t from, std::size_t to) {
+        auto& target = clusters[to];
+        target.insert(target.end(), clusters[from].begin(), clusters[from].end());
+        clusters[from].clear();
+        if (holds_hip[from]) holds_hip[to] = true;
+    };
+    for (std::size_t b = bones; b-- > 0;) {
+        if (clusters[b].empty() || !extremity(region_of(b))) continue;
+        std::size_t top = b;
+        while (skeleton.parents[top] >= 0 && region_of(static_cast<std::size_t>(skeleton.parents[top])) == region_of(b))
+            top = static_cast<std::size_t>(skeleton.parents[top]);
+        if (top != b) move(b, top);
+    }
+    for (std::size_t b = 0; b < bones; ++b) {
+        if (clusters[b].empty() || !extremity(region_of(b))) continue;
+        for (std::size_t s = b + 1; s < bones; ++s)
+            if (!clusters[s].empty() && skeleton.parents[s] == skeleton.parents[b] && region_of(s) == region_of(b))
+                move(s, b);
+    }
+
+    std::vector<EllipsoidShape> shapes;
+    for (std::size_t b = 0; b < bones; ++b) {
+        const auto& c = clusters[b];
+        if (c.size() < 4) continue;
+        const Affine3 to_bone = frame[b].inverse();
+        Matrix3X q(3, static_cast<Eigen::Index>(c.size()));
+        for (std::size_t i = 0; i < c.size(); ++i) q.col(static_cast<Eigen::Index>(i)) = to_bone * mesh.bind_positions.col(c[i]);
+        const Vec3 mean = q.rowwise().mean();
+        Mat3 covariance = Mat3::Zero();
+        for (Eigen::Index i = 0; i < q.cols(); ++i) {
+            const Vec3 d = q.col(i) - mean;
+            covariance.noalias() += d * d.transpose();
+        }
+        covariance /= Real(c.size());
+        Eigen::SelfAdjointEigenSolver<Mat3> eig(covariance);
+        Mat3 axes = eig.eigenvectors();
+        if (!axes.allFinite()) axes.setIdentity();
+        if (axes.determinant() < 0) axes.col(0) *= -1;
+        const Matrix3X y = axes.transpose().lazyProduct(q);  // cluster in the principal frame
+        const Vec3 lo = y.rowwise().minCoeff(), hi = y.rowwise().maxCoeff();
+        const Vec3 centre_y = (lo + hi) / 2;
+        const Vec3 half = ((hi - lo) / 2).cwiseMax(static_cast<Real>(options.min_radius_m));
+        std::vector<Real> d(c.size());
+        for (std::size_t i = 0; i < c.size(); ++i)
+            d[i] = ((y.col(static_cast<Eigen::Index>(i)) - centre_y).cwiseQuotient(half)).norm();
+        const auto k = std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(options.cluster_coverage * double(d.size()))) - 1);
+        std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+        const Real s = std::max(d[k], Real(1e-3));
+
+        EllipsoidShape shape;
+        shape.bone = static_cast<int>(b);
+        shape.center = axes * centre_y;
+        shape.rotation = Quat(axes).normalized();
+        shape.radii_m = (half * s).cwiseMax(static_cast<Real>(options.min_radius_m));
+        shape.region = holds_hip[b] ? BodyRegion::pelvis : region_from_bone_name(skeleton.bone_names[b]);
+        shapes.push_back(shape);
+    }
+    // No cluster holds the hip bone's vertices (a rig whose pelvis mesh hangs from a
+    // sibling bone): the trunk ellipsoid nearest the hip joint stands for the pelvis.
+    const bool has_pelvis = std::any_of(shapes.begin(), shapes.end(), [](auto& s) { return s.region == BodyRegion::pelvis; });
+    if (!has_pelvis && hip >= 0) {
+        const Vec3 hip_at = frame[static_cast<std::size_t>(hip)].translation();
+        EllipsoidShape* nearest = nullptr;
+        Real best = std::numeric_limits<Real>::max();
+        for (EllipsoidShape& s : shapes) {
+            if (s.region != BodyRegion::other && s.region != BodyRegion::torso) continue;
+            const Real d = (frame[static_cast<std::size_t>(s.bone)] * s.center - hip_at).norm();
+            if (d < best) { best = d; nearest = &s; }
+        }
+        if (nearest != nullptr) nearest->region = BodyRegion::pelvis;
+    }
+    return shapes;
+}
+
+Affine3 ellipsoid_transform(const EllipsoidShape& shape, const Affine3& bone_global) {
+    Affine3 local = Affine3::Identity();
+    local.translate(shape.center);
+    local.rotate(shape.rotation);
+    local.scale(shape.radii_m);
+    return rigid_part(bone_global) * local;
+}
+
+Real outside_distance(const Affine3& e, const Vec3& point) {
+    const Vec3 u = e.inverse(Eigen::Affine) * point;
+    const Real r = u.norm();
+    if (r <= 1) return 0;
+    return (point - e * Vec3(u / r)).norm();
+}
+
+CoverageReport measure_coverage(std::span<const EllipsoidShape> shapes, std::span<const Affine3> global,
+                                const Matrix3X& positions, const Matrix3X& normals, double tolerance_m) {
+    CoverageReport report;
+    report.tolerance_m = tolerance_m;
+    report.vertices = static_cast<std::size_t>(positions.cols());
+    std::vector<Affine3> e, e_inverse;
+    for (const EllipsoidShape& s : shapes) {
+        if (s.bone < 0 || static_cast<std::size_t>(s.bone) >= global.size()) continue;
+        e.push_back(ellipsoid_transform(s, global[static_cast<std::size_t>(s.bone)]));
+        e_inverse.push_back(e.back().inverse(Eigen::Affine));
+    }
+    const Eigen::Index n = positions.cols();
+    std::vector<Real> gap(static_cast<std::size_t>(n), std::numeric_limits<Real>::infinity());
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 1024), [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index j = r.begin(); j < r.end(); ++j) {
+            Real best = std::numeric_limits<Real>::infinity();
+            const Vec3 p = positions.col(j);
+            for (std::size_t k = 0; k < e.size() && best > 0; ++k) {
+                const Vec3 u = e_inverse[k] * p;
+                const Real len = u.norm();
+                best = std::min(best, len <= 1 ? Real(0) : (p - e[k] * Vec3(u / len)).norm());
+            }
+            gap[static_cast<std::size_t>(j)] = best;
+        }
+    });
+    for (Real g : gap) {
+        if (g <= tolerance_m) ++report.covered;
+        else report.max_gap_m = std::max(report.max_gap_m, double(g));
+    }
+    report.coverage = report.vertices ? double(report.covered) / double(report.vertices) : 0;
+
+    // Bulge: surface samples against the nearest vertex and its outward normal.
+    const Matrix3X unit = sphere_samples(192);
+    report.bulge_per_ellipsoid_m.assign(e.size(), 0);
+    std::vector<std::vector<Real>> bulges(e.size());
+    tbb::parallel_for(std::size_t(0), e.size(), [&](std::size_t k) {
+        const Matrix3X samples = (e[k].linear().lazyProduct(unit)).colwise() + e[k].translation();
+        auto& out = bulges[k];
+        for (Eigen::Index s = 0; s < samples.cols(); ++s) {
+            Eigen::Index nearest = 0;
+            (positions.colwise() - samples.col(s)).colwise().squaredNorm().minCoeff(&nearest);
+            const Real outward = (samples.col(s) - positions.col(nearest)).dot(normals.col(nearest));
+            if (outward > 0) out.push_back(outward);
+        }
+    });
+    std::vector<Real> all;
+    for (std::size_t k = 0; k < e.size(); ++k) {
+        for (Real b : bulges[k]) report.bulge_per_ellipsoid_m[k] = std::max(report.bulge_per_ellipsoid_m[k], double(b));
+        all.insert(all.end(), bulges[k].begin(), bulges[k].end());
+    }
+    if (!all.empty()) {
+        double sum = 0;
+        for (Real b : all) sum += b;
+        report.mean_bulge_m = sum / double(all.size());
+        std::sort(all.begin(), all.end());
+        report.p95_bulge_m = all[std::min(all.size() - 1, static_cast<std::size_t>(0.95 * double(all.size())))];
+        report.max_bulge_m = all.back();
+    }
+    return report;
+}
+
+Result<std::vector<EllipsoidShape>> ellipsoids_from_json(std::string_view json_text, const SkeletonAsset& skeleton,
+                                                        std::string_view source) {
+    const std::string at(source);
+    nlohmann::json doc = nlohmann::json::parse(json_text, nullptr, false);
+    if (doc.is_discarded()) return fail(at + ": colliders: not valid JSON");
+    if (!doc.is_array()) return fail(at + ": colliders: must be an array");
+    auto read_vec = [&](const nlohmann::json& item, const std::string& field, std::size_t count,
+                        std::vector<double>& out) -> Result<void> {
+        if (!item.contains(field)) return fail(at + ": " + field + ": missing");
+        const auto& v = item.at(field);
+        if (!v.is_array() || v.size() != count) return fail(at + ": " + field + ": must be an array of " + std::to_string(count) + " numbers");
+        out.clear();
+        for (const auto& x : v) {
+            if (!x.is_number() || !std::isfinite(x.get<double>())) return fail(at + ": " + field + ": must hold finite numbers");
+            out.push_back(x.get<double>());
+        }
+        return {};
+    };
+    std::vector<EllipsoidShape> shapes;
+    for (std::size_t i = 0; i < doc.size(); ++i) {
+        const auto& item = doc[i];
+        const std::string field = "colliders[" + std::to_string(i) + "]";
+        if (!item.is_object()) return fail(at + ": " + field + ": must be an object");
+        EllipsoidShape s;
+        if (!item.contains("bone") || !item["bone"].is_string()) return fail(at + ": " + field + ".bone: must be a bone name");
+        const std::string bone = item["bone"].get<std::string>();
+        s.bone = skeleton.find(bone);
+        if (s.bone < 0) return fail(at + ": " + field + ".bone: no bone named '" + bone + "'");
+        std::vector<double> v;
+        if (auto ok = read_vec(item, "center", 3, v); !ok) return fail(at + ": " + field + "." + ok.error().message.substr(at.size() + 2));
+        s.center = Vec3(static_cast<Real>(v[0]), static_cast<Real>(v[1]), static_cast<Real>(v[2]));
+        if (auto ok = read_vec(item, "radii_m", 3, v); !ok) return fail(at + ": " + field + "." + ok.error().message.substr(at.size() + 2));
+        if (v[0] <= 0 || v[1] <= 0 || v[2] <= 0) return fail(at + ": " + field + ".radii_m: must be > 0");
+        s.radii_m = Vec3(static_cast<Real>(v[0]), static_cast<Real>(v[1]), static_cast<Real>(v[2]));
+        if (item.contains("rotation")) {
+            if (auto ok = read_vec(item, "rotation", 4, v); !ok) return fail(at + ": " + field + "." + ok.error().message.substr(at.size() + 2));
+            Quat q(static_cast<Real>(v[3]), static_cast<Real>(v[0]), static_cast<Real>(v[1]), static_cast<Real>(v[2]));
+            if (q.norm() < 1e-6f) return fail(at + ": " + field + ".rotation: must be a non-zero quaternion [x, y, z, w]");
+            s.rotation = q.normalized();
+        }
+        s.region = region_from_bone_name(bone);
+        if (item.contains("region")) {
+            const auto r = item["region"].is_string() ? region_from_string(item["region"].get<std::string>()) : std::nullopt;
+            if (!r) return fail(at + ": " + field + ".region: unknown region (head, neck, torso, pelvis, upper_arm, lower_arm, hand, upper_leg, lower_leg, foot, other)");
+            s.region = *r;
+        }
+        shapes.push_back(s);
+    }
+    return shapes;
+}
+
+std::vector<EllipsoidShape> apply_overrides(std::span<const EllipsoidShape> fitted, std::span<const EllipsoidShape> overrides,
+                                            bool replace_all) {
+    std::vector<EllipsoidShape> out;
+    if (!replace_all)
+        for (const EllipsoidShape& f : fitted) {
+            const bool overridden = std::any_of(overrides.begin(), overrides.end(), [&](const EllipsoidShape& o) { return o.bone == f.bone; });
+            if (!overridden) out.push_back(f);
+        }
+    out.insert(out.end(), overrides.begin(), overrides.end());
+    return out;
+}
+
+}  // namespace drape

@@ -1,0 +1,61 @@
+// Skeletal animation and skinning as free functions on Eigen data (method §1.1, §1.2).
+//
+// A frame: wrap the clip time, sample every channel into local bone transforms (lerp for
+// translation and scale, slerp for rotation), compose them down the hierarchy (parents
+// come before children), form the skinning matrices global * inverse_bind, and blend
+// them per vertex (linear blend skinning). The systems in systems/*_system.cpp only
+// call these.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "components/animation_player.hpp"
+#include "components/skeleton.hpp"
+#include "components/skinned_mesh.hpp"
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// Where a playback time falls in a clip.
+struct ClipTime {
+    double time_s = 0;   ///< In [0, duration].
+    int cycles = 0;      ///< Whole loops before it (0 when not looping).
+};
+
+/// Wraps `time_s` into the clip: modulo the duration when looping, clamped otherwise.
+[[nodiscard]] ClipTime wrap_clip_time(double time_s, double duration_s, bool loop) noexcept;
+
+/// TRS -> affine (translation * rotation * scale).
+[[nodiscard]] Affine3 compose_trs(const Vec3& translation, const Quat& rotation, const Vec3& scale) noexcept;
+
+/// Local pose at `time_s` (seconds within the clip). Bones the clip does not animate keep
+/// their rest pose; channels for out-of-range bones are ignored. `in_place` removes the
+/// clip's horizontal travel from its motion bone. `local` is resized to the skeleton.
+void sample_clip(const AnimationClip& clip, const SkeletonAsset& skeleton, double time_s, bool in_place,
+                 std::vector<Affine3>& local);
+
+/// The rest (node) pose.
+void rest_pose(const SkeletonAsset& skeleton, std::vector<Affine3>& local);
+
+/// Composes local transforms down the hierarchy into model space. Parents precede children.
+void compose_pose(const SkeletonAsset& skeleton, std::span<const Affine3> local, std::vector<Affine3>& global);
+
+/// global * inverse_bind per bone: bind model space -> current model space.
+void skinning_matrices(const SkeletonAsset& skeleton, std::span<const Affine3> global,
+                       std::vector<Affine3>& skinning);
+
+/// Linear blend skinning of every vertex: positions and normals in the space `to_space`
+/// maps model space to (the character's Transform for world space). Runs in parallel
+/// over blocks of vertices for big meshes. Outputs are resized.
+void skin_mesh(const MeshAsset& mesh, std::span<const Affine3> skinning, const Affine3& to_space,
+               Matrix3X& positions, Matrix3X& normals);
+
+/// The same for positions only (fitting, coverage, cloth pinning).
+void skin_positions(const MeshAsset& mesh, std::span<const Affine3> skinning, const Affine3& to_space,
+                    Matrix3X& positions);
+
+/// The rigid part of a transform (rotation and translation; scale and shear removed).
+[[nodiscard]] Affine3 rigid_part(const Affine3& transform) noexcept;
+
+}  // namespace drape
