@@ -9,8 +9,11 @@
 
 namespace drape {
 
-GarmentWatch::GarmentWatch(std::vector<Entity> garments) {
-    for (Entity e : garments) m_tracks.push_back(Track{e});
+GarmentWatch::GarmentWatch(const Registry& registry, std::vector<Entity> garments) {
+    for (Entity e : garments) {
+        const Garment* g = registry.try_get<Garment>(e);
+        m_tracks.push_back(Track{.entity = e, .tests_at_start = g ? g->counters.collision_tests : 0});
+    }
 }
 
 void GarmentWatch::sample(const Registry& registry) {
@@ -18,10 +21,6 @@ void GarmentWatch::sample(const Registry& registry) {
     for (Track& t : m_tracks) {
         const Garment* g = registry.try_get<Garment>(t.entity);
         if (g == nullptr) continue;
-        if (!t.started) {  // tests counted before the first frame (e.g. at build) are not the run's
-            t.started = true;
-            t.tests_at_start = g->counters.collision_tests;
-        }
         const GarmentCounters& c = g->counters;
         if (std::isfinite(c.max_strain)) t.max_strain = std::max(t.max_strain, double(c.max_strain));
         if (std::isfinite(c.max_penetration_m)) t.max_penetration_m = std::max(t.max_penetration_m, double(c.max_penetration_m));

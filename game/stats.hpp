@@ -40,8 +40,9 @@ struct RunStats {
 /// Follows garments over a run.
 class GarmentWatch {
 public:
-    /// Starts watching these Garment entities (scene order).
-    explicit GarmentWatch(std::vector<Entity> garments = {});
+    GarmentWatch() = default;
+    /// Starts watching these Garment entities (scene order); counts before now are not the run's.
+    GarmentWatch(const Registry& registry, std::vector<Entity> garments);
     /// Reads counters and particles after a frame.
     void sample(const Registry& registry);
     /// Per garment, over `frames` frames sampled so far.
@@ -54,7 +55,6 @@ private:
         double max_strain = 0, max_penetration_m = 0;
         std::uint64_t nonfinite_seen = 0;    ///< Particles found non-finite by sample().
         std::uint64_t tests_at_start = 0;
-        bool started = false;
     };
     std::vector<Track> m_tracks;
     std::uint64_t m_frames = 0;
