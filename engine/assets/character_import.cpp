@@ -308,6 +308,11 @@ Result<void> build_mesh(Builder& b, MeshAsset& out, std::vector<MeshInfo>& infos
             if (inf.size() > 4) inf.resize(4);
             float sum = 0;
             for (auto& [i, w] : inf) sum += w;
+            if (sum <= 1e-8f && mesh->mNumBones > 0)
+                // assimp drops weights it cannot read (NaN in glTF): a skinned vertex left
+                // without any is bad data, not a rigid part.
+                return fail(b.at() + ": mesh '" + mesh_name + "': vertex " + std::to_string(v) +
+                            " has no finite, positive bone weight (non-finite or missing weights)");
             if (sum <= 1e-8f) {
                 any_rigid = true;
                 out.bone_indices.col(j) << rigid_bone, 0, 0, 0;

@@ -1,0 +1,21 @@
+// The animation system (phase animation, method §1.1): advances each AnimationPlayer by
+// the fixed step, samples its clip (lerp, slerp), composes the pose down the hierarchy
+// and keeps Skeleton::skinning = global * inverse_bind current, so the cloth can skin its
+// pinned particles without the mesh. Root motion (AnimationPlayer::in_place = false)
+// advances the Transform by the clip's travel each time the clip loops.
+#pragma once
+
+#include "engine/core/scheduler.hpp"
+
+namespace drape {
+
+[[nodiscard]] System make_animation_system();
+
+struct AnimationPlayer;
+struct Skeleton;
+struct Transform;
+
+/// One entity's update, as the system runs it (tests call it without a scheduler).
+void advance_animation(AnimationPlayer& player, Skeleton& skeleton, Transform* transform, double dt_s);
+
+}  // namespace drape

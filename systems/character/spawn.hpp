@@ -1,0 +1,39 @@
+// Putting a character into a scene: one entity with Character, Transform, Skeleton,
+// SkinnedMesh and AnimationPlayer, and one entity per EllipsoidCollider pointing back at it.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/transform.hpp"
+#include "engine/assets/character_asset.hpp"
+#include "engine/core/error.hpp"
+#include "engine/core/registry.hpp"
+
+namespace drape {
+
+struct SpawnOptions {
+    Transform transform;
+    std::string clip;                  ///< Name or index; empty = the first clip (none: rest pose).
+    double speed = 1;                  ///< Playback rate.
+    bool loop = true;
+    bool in_place = true;              ///< false: root motion moves the Transform.
+    double start_time_s = 0;           ///< Where in the clip to start.
+    std::vector<EllipsoidShape> collider_overrides;  ///< Replace the fitted ellipsoids of their bones (or add).
+    bool replace_fitted_colliders = false;           ///< Use only the overrides.
+};
+
+/// Creates the character and its colliders, posed at the start time and skinned, so
+/// they are valid before the first step. Errors name the character's file and the field.
+[[nodiscard]] Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const CharacterAsset> asset,
+                                             const SpawnOptions& options = {});
+
+/// The collider entities of a character.
+[[nodiscard]] std::vector<Entity> colliders_of(Registry& registry, Entity character);
+
+/// Destroys a character and its colliders.
+void despawn_character(Registry& registry, Entity character);
+
+}  // namespace drape
