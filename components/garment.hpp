@@ -1,12 +1,27 @@
 // A garment: a cooked, shared topology (the "fabric") and light per-instance particle
 // state in structure-of-arrays form (method §3, §4, §5).
 //
+// Conventions
+// - The garment is an m x n particle grid: `warp_lines` lines of `particles_per_line`
+//   particles; a line runs along the warp (down from the fitting zone), a row along the
+//   weft. Every `weft_stride`-th warp line is layer 1 (integrated, method §3.2); the lines
+//   between are layer 2 (placed from their layer-1 neighbours, method §4.2).
+// - Particles are stored layer 1 first: columns [0, layer1_count) of `x` are the layer-1
+//   particles, so the simplified model integrates one contiguous block.
+// - Springs are flat parallel index arrays (`SpringPhase`). Warp springs are listed line by
+//   line from the fitting zone outward: `a` is the end nearer the pins.
+// - `inv_mass` is the same in both models (total mass / particle count, 0 = pinned). In the
+//   simplified model a layer-1 particle carries the mass, drag and spring stiffness of the
+//   weft particles it stands for (`layer1_mass_scale`).
+//
 // The cloth systems own the meaning of most fields; the render system reads only
 // `x`, `topology->triangles` and `color`.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/core/math.hpp"
@@ -26,9 +41,109 @@ enum class CollisionMode : std::uint8_t {
     brute_force,      ///< Every particle against every ellipsoid.
 };
 
+/// Springs of one kind as flat parallel arrays (one entry per spring).
+struct SpringPhase {
+    std::vector<std::uint32_t> a;   ///< First particle (for warp springs: nearer the pins).
+    std::vector<std::uint32_t> b;   ///< Second particle.
+    std::vector<Real> rest_m;       ///< Rest length, > 0.
+
+    [[nodiscard]] std::size_t size() const noexcept { return a.size(); }
+    void add(std::uint32_t i, std::uint32_t j, Real rest) { a.push_back(i); b.push_back(j); rest_m.push_back(rest); }
+};
+
 /// Immutable garment data shared by every instance.
 struct GarmentTopology {
+    std::uint32_t warp_lines = 0;           ///< n: lines along the warp.
+    std::uint32_t particles_per_line = 0;   ///< m: particles on each warp line.
+    std::uint32_t weft_stride = 1;          ///< Every weft_stride-th line is layer 1.
+    bool closed = false;                    ///< The weft wraps around (skirt, dress).
+    std::uint32_t layer1_count = 0;         ///< Particles [0, layer1_count) are layer 1.
+    Real layer1_mass_scale = 1;             ///< Particles a layer-1 particle stands for.
+
+    std::vector<std::uint32_t> grid;        ///< Particle index of (line, row): grid[line * m + row].
+    std::vector<std::uint8_t> layer;        ///< 1 or 2 per particle.
     std::vector<std::uint32_t> triangles;   ///< Render triangles over the particle grid.
+
+    // Layer-1 springs (method §3.2, §4.1).
+    SpringPhase warp1;       ///< Warp springs between layer-1 particles: the simplified model's only forces.
+    // Layer 2 and the classic model.
+    SpringPhase warp2;       ///< Warp springs on layer-2 lines.
+    SpringPhase weft;        ///< Weft (structural) springs between neighbouring lines.
+    SpringPhase shear;       ///< Classic only: grid diagonals.
+    SpringPhase bend;        ///< Classic only: every second particle, warp and weft.
+
+    // Weft placement (method §4.2), one entry per layer-2 particle.
+    std::vector<std::uint32_t> weft_particle;  ///< The layer-2 particle.
+    std::vector<std::uint32_t> weft_left;      ///< Its layer-1 neighbour before it along the weft.
+    std::vector<std::uint32_t> weft_right;     ///< Its layer-1 neighbour after it.
+    std::vector<Real> weft_t;                  ///< Fraction of the way from left to right, (0, 1).
+    // Normal stencil of each layer-1 particle: n = (x[up] - x[down]) x (x[next] - x[prev]).
+    std::vector<std::uint32_t> normal_up, normal_down, normal_prev, normal_next;
+
+    [[nodiscard]] std::size_t particle_count() const noexcept { return layer.size(); }
+};
+
+/// What a pin follows.
+enum class PinKind : std::uint8_t {
+    world,     ///< Fixed in world space at `local` (flat test cloth).
+    collider,  ///< Rigidly bound to an ellipsoid: `local` in its unit-sphere frame.
+    skinned,   ///< Skinned like a skin vertex: `local` in bind model space, `bones`/`weights`
+               ///< blended with Skeleton::skinning, then the character's Transform.
+};
+
+/// What one particle is pinned to (method §3.5). Only particles with inv_mass == 0 have one.
+struct PinBinding {
+    std::uint32_t particle = 0;
+    PinKind kind = PinKind::world;
+    std::int32_t collider = -1;             ///< PinKind::collider: index into Garment::colliders.
+    Vec3 local = Vec3::Zero();              ///< See PinKind.
+    Vec4i bones = Vec4i::Zero();            ///< Skinned pin: up to 4 bone indices.
+    Vec4 weights = Vec4::Zero();            ///< Skinned pin: weights, sum 1 (unused: weight 0).
+};
+
+/// Material and solver settings of one garment instance.
+struct ClothMaterial {
+    Real mass_kg = Real(0.35);              ///< Whole garment.
+    Real stretch_k_N_m = Real(0.9);         ///< Per stretch spring of the full grid.
+    Real shear_k_N_m = Real(0.45);          ///< Classic only.
+    Real bend_k_N_m = Real(0.2);            ///< Classic only.
+    Real drag_N_s_m = Real(0.0012);         ///< Air drag per particle of the full grid (method §3.3 k).
+    Real strain_limit = Real(0.10);         ///< Provot: max relative over-stretch (method §4.1).
+    int strain_iterations = 2;              ///< Symmetric Provot passes before the ordered pass.
+    Real candidate_margin_m = Real(0.08);   ///< Candidate lists: reach beyond the surface (method §5).
+    friend bool operator==(const ClothMaterial&, const ClothMaterial&) = default;
+};
+
+/// Per-garment counters. `frame_*` restart each fixed step; the rest accumulate.
+struct GarmentCounters {
+    std::uint64_t frame_collision_tests = 0;  ///< Unit-sphere tests this fixed step (all substeps).
+    std::uint64_t frame_collisions = 0;       ///< Particle-ellipsoid contacts resolved this step.
+    std::uint64_t frame_list_rebuild_tests = 0; ///< Candidate-list (broad phase) tests this step.
+    Real max_strain = 0;                      ///< Largest warp/weft spring length / rest - 1 after constraints, last substep.
+    Real max_penetration_m = 0;               ///< Deepest penetration found this step (before response).
+    int substeps = 1;                         ///< Substeps of the last fixed step (all garments share it).
+    int substeps_stability = 1;               ///< This garment's need from the stability bound (method §3.4).
+    int substeps_motion = 1;                  ///< This garment's need from collider surface travel.
+    std::uint64_t unresolved = 0;             ///< Particles left inside overlapping ellipsoids after the re-test cap.
+    std::uint64_t collision_tests = 0;        ///< Totals since creation.
+    std::uint64_t collisions = 0;
+    std::uint64_t list_rebuilds = 0;
+    std::uint64_t list_rebuild_tests = 0;
+    std::uint64_t non_finite_values = 0;      ///< Non-finite coordinates found (then the garment was reset).
+    std::uint64_t resets = 0;                 ///< Resets (non-finite state, or reset_garment()).
+    std::uint64_t steps = 0;                  ///< Fixed steps simulated.
+};
+
+/// One collider as the cloth sees it during a substep (unit sphere <-> world).
+struct EllipsoidFrame {
+    Mat3 to_unit = Mat3::Identity();   ///< diag(1/r) R^T.
+    Mat3 rotation = Mat3::Identity();  ///< R.
+    Vec3 center = Vec3::Zero();        ///< c, m.
+    Vec3 radii_m = Vec3::Ones();
+    Vec3 velocity_m_s = Vec3::Zero();
+    Vec3 acceleration_m_s2 = Vec3::Zero();
+    Vec3 angular_velocity_rad_s = Vec3::Zero();
+    bool active = false;               ///< False when the collider entity is gone: never tested.
 };
 
 struct Garment {
@@ -37,10 +152,38 @@ struct Garment {
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.75f, 0.12f, 0.18f);  ///< Linear RGB.
+    ClothMaterial material;
 
     Matrix3X x;         ///< Particle positions, world, m.
     Matrix3X v;         ///< Particle velocities, m/s.
     VectorX inv_mass;   ///< 1/kg; 0 = pinned.
+
+    // Body.
+    std::vector<Entity> colliders;           ///< EllipsoidCollider entities the garment collides with (<= 64).
+    std::int32_t anchor = -1;                ///< Collider whose rigid motion is "the body" of method §3.3 (-1: none).
+    std::vector<PinBinding> pins;            ///< One per pinned particle.
+    Matrix3X rest_local;                     ///< Rest shape in the anchor's frame (rotation + centre), for reset_garment().
+
+    // Collision state (method §5).
+    std::vector<std::uint64_t> candidates;   ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
+    std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep.
+    bool lists_valid = false;                ///< False: rebuild the candidate lists before the next test.
+    Matrix3X list_anchor_x;                  ///< Particle positions (anchor frame) when the lists were built.
+    std::vector<Affine3> list_anchor_frames; ///< Unit sphere -> anchor frame of each collider then.
+
+    GarmentCounters counters;
+
+    // Scratch and caches the systems keep between substeps (no allocation per step).
+    Matrix3X force;                          ///< Spring forces, N.
+    Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
+    Matrix3X normals;                        ///< Layer-1 normals for weft placement.
+    Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.
+    std::vector<std::uint8_t> movable;       ///< Per particle: 1 unless pinned.
+    std::vector<std::uint8_t> movable_weft;  ///< Per particle: 1 for free layer-2 particles.
+    std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep.
+    std::array<Real, 2> stable_step_s{0, 0}; ///< Stability bound per model (method §3.4), for `cached_material`.
+    ClothMaterial cached_material;
+    bool stability_valid = false;
 };
 
 }  // namespace drape

@@ -1,0 +1,70 @@
+// Collider frames for the cloth (method §2, §5); see body.hpp for conventions.
+#include "systems/cloth/body.hpp"
+
+#include <algorithm>
+
+namespace drape {
+
+EllipsoidFrame make_ellipsoid_frame(const Affine3& unit_to_world) {
+    EllipsoidFrame f;
+    const Mat3 linear = unit_to_world.linear();
+    for (int i = 0; i < 3; ++i) {
+        const Real r = linear.col(i).norm();
+        f.radii_m[i] = r;
+        f.rotation.col(i) = r > 0 ? Vec3(linear.col(i) / r) : Vec3::Unit(i);
+    }
+    f.center = unit_to_world.translation();
+    f.to_unit = f.radii_m.cwiseInverse().asDiagonal() * f.rotation.transpose();
+    f.active = (f.radii_m.array() > 0).all() && f.to_unit.allFinite() && f.center.allFinite();
+    return f;
+}
+
+Affine3 unit_to_world(const EllipsoidFrame& frame) {
+    Affine3 t = Affine3::Identity();
+    t.linear() = frame.rotation * frame.radii_m.asDiagonal();
+    t.translation() = frame.center;
+    return t;
+}
+
+EllipsoidFrame interpolate_collider(const EllipsoidCollider& collider, Real alpha) {
+    EllipsoidFrame frame;
+    if (!collider.initialised || alpha >= 1) {
+        frame = make_ellipsoid_frame(collider.world);
+    } else {
+        const EllipsoidFrame a = make_ellipsoid_frame(collider.previous_world);
+        const EllipsoidFrame b = make_ellipsoid_frame(collider.world);
+        Affine3 t = Affine3::Identity();
+        const Quat q = Quat(a.rotation).slerp(alpha, Quat(b.rotation));
+        t.linear() = q.toRotationMatrix() * ((1 - alpha) * a.radii_m + alpha * b.radii_m).asDiagonal();
+        t.translation() = (1 - alpha) * a.center + alpha * b.center;
+        frame = make_ellipsoid_frame(t);
+    }
+    frame.velocity_m_s = collider.velocity_m_s;
+    frame.acceleration_m_s2 = collider.acceleration_m_s2;
+    frame.angular_velocity_rad_s = collider.angular_velocity_rad_s;
+    return frame;
+}
+
+void update_frames(const Registry& registry, Garment& garment, Real alpha) {
+    garment.frames.resize(garment.colliders.size());
+    for (std::size_t i = 0; i < garment.colliders.size(); ++i) {
+        const EllipsoidCollider* c = registry.try_get<EllipsoidCollider>(garment.colliders[i]);
+        if (c == nullptr) {
+            garment.frames[i].active = false;
+            continue;
+        }
+        garment.frames[i] = interpolate_collider(*c, alpha);
+    }
+}
+
+Affine3 anchor_frame(const Garment& garment) {
+    Affine3 t = Affine3::Identity();
+    if (garment.anchor < 0 || static_cast<std::size_t>(garment.anchor) >= garment.frames.size()) return t;
+    const EllipsoidFrame& f = garment.frames[static_cast<std::size_t>(garment.anchor)];
+    if (!f.active) return t;
+    t.linear() = f.rotation;
+    t.translation() = f.center;
+    return t;
+}
+
+}  // namespace drape

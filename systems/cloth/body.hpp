@@ -1,0 +1,42 @@
+// The body as the cloth sees it: ellipsoid colliders at a point of the fixed step, and the
+// rigid motion of the garment's anchor (method §2, §3.3, §5).
+//
+// Conventions: a collider's `world` maps the unit sphere to world space as
+// translation * rotation * scale (no shear). Within a fixed step the cloth takes several
+// substeps; a collider at fraction alpha of the step is interpolated between
+// `previous_world` (alpha 0) and `world` (alpha 1): centre and radii linearly, rotation by
+// slerp. Velocity, acceleration and angular velocity are the collider system's, constant
+// over the step.
+#pragma once
+
+#include <span>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "engine/core/math.hpp"
+#include "engine/core/registry.hpp"
+
+namespace drape {
+
+/// A frame from a unit-sphere -> world transform (translation * rotation * scale).
+[[nodiscard]] EllipsoidFrame make_ellipsoid_frame(const Affine3& unit_to_world);
+
+/// The collider at fraction `alpha` in [0, 1] of the current fixed step.
+[[nodiscard]] EllipsoidFrame interpolate_collider(const EllipsoidCollider& collider, Real alpha);
+
+/// Unit-sphere -> world transform of a frame.
+[[nodiscard]] Affine3 unit_to_world(const EllipsoidFrame& frame);
+
+/// Refreshes `garment.frames` (one per entry of `garment.colliders`) at `alpha`.
+/// A collider whose entity is gone becomes inactive. No allocation once sized.
+void update_frames(const Registry& registry, Garment& garment, Real alpha);
+
+/// Rigid frame (rotation + centre, no scale) of the garment's anchor collider, or identity.
+[[nodiscard]] Affine3 anchor_frame(const Garment& garment);
+
+/// Velocity of the body point at `x` carried by `frame`'s rigid motion: v_c + w x (x - c).
+[[nodiscard]] inline Vec3 body_velocity_at(const EllipsoidFrame& frame, const Vec3& x) {
+    return frame.velocity_m_s + frame.angular_velocity_rad_s.cross(x - frame.center);
+}
+
+}  // namespace drape

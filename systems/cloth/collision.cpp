@@ -1,0 +1,221 @@
+// Particle-ellipsoid collision (method §5); step order in collision.hpp.
+#include "systems/cloth/collision.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include "systems/cloth/body.hpp"
+
+namespace drape {
+namespace {
+
+// A pushed-out particle sits this fraction outside the surface so that float rounding
+// cannot leave it a hair inside (0.3 um on a 30 cm ellipsoid).
+constexpr Real surface_clearance = Real(1e-6);
+// Re-test rounds for a particle pushed between overlapping ellipsoids.
+constexpr int max_retest_rounds = 8;
+
+template <class F>
+inline void for_each_bit(std::uint64_t bits, F&& f) {
+    while (bits != 0) {
+        const int e = std::countr_zero(bits);
+        bits &= bits - 1;
+        f(e);
+    }
+}
+
+}  // namespace
+
+Real penetration_depth(const EllipsoidFrame& f, const Vec3& x) {
+    const Real y_sq = to_unit_sphere(f, x).squaredNorm();
+    if (y_sq >= 1) return 0;
+    const Real y = std::sqrt(y_sq);
+    if (y <= Real(1e-6)) return f.radii_m.minCoeff();
+    return (x - f.center).norm() * (1 / y - 1);
+}
+
+void push_out(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x, Vec3& v) {
+    Vec3 y = y_in;
+    Real length = y.norm();
+    if (length <= Real(1e-6)) {  // at the centre: no centre line; leave along the longest axis
+        Eigen::Index axis = 0;
+        f.radii_m.maxCoeff(&axis);
+        y = Vec3::Unit(axis);
+        length = 1;
+    }
+    const Vec3 y_surface = y * ((1 + surface_clearance) / length);
+    x = f.center + f.rotation * f.radii_m.cwiseProduct(y_surface);
+    const Vec3 normal = (f.to_unit.transpose() * y_surface).normalized();
+    const Vec3 surface_velocity = body_velocity_at(f, x);
+    const Real approach = (v - surface_velocity).dot(normal);
+    if (approach < 0) v -= approach * normal;
+}
+
+std::uint64_t active_mask(std::span<const EllipsoidFrame> frames) {
+    std::uint64_t mask = 0;
+    for (std::size_t e = 0; e < frames.size() && e < 64; ++e)
+        if (frames[e].active) mask |= std::uint64_t(1) << e;
+    return mask;
+}
+
+std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
+                                    std::vector<std::uint64_t>& candidates) {
+    const Eigen::Index n = x.cols();
+    candidates.assign(static_cast<std::size_t>(n), 0);
+    std::uint64_t tests = 0;
+    for (std::size_t e = 0; e < frames.size() && e < 64; ++e) {
+        const EllipsoidFrame& f = frames[e];
+        if (!f.active) continue;
+        const Real reach = 1 + margin / f.radii_m.minCoeff();
+        const Real reach_sq = reach * reach;
+        const std::uint64_t bit = std::uint64_t(1) << e;
+        for (Eigen::Index p = 0; p < n; ++p)
+            if ((f.to_unit * (x.col(p) - f.center)).squaredNorm() <= reach_sq) candidates[static_cast<std::size_t>(p)] |= bit;
+        tests += static_cast<std::uint64_t>(n);
+    }
+    return tests;
+}
+
+CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
+                                  std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
+                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected) {
+    CollisionResult r;
+    const Eigen::Index n = x.cols();
+    last_collided.resize(static_cast<std::size_t>(n), 0);
+    if (detected) detected->assign(static_cast<std::size_t>(n), 0);
+    const std::uint64_t active = active_mask(frames);
+
+    for (Eigen::Index p = 0; p < n; ++p) {
+        const std::size_t pi = static_cast<std::size_t>(p);
+        if (inv_mass[p] == 0) {
+            last_collided[pi] = 0;
+            continue;
+        }
+        const std::uint64_t list = (candidates ? (*candidates)[pi] : ~std::uint64_t(0)) & active;
+        const std::uint64_t last = last_collided[pi] & list;
+        Vec3 xp = x.col(p);
+        std::uint64_t hits = 0;
+        auto detect = [&](int e) {
+            ++r.tests;
+            const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+            const Vec3 y = to_unit_sphere(f, xp);
+            const Real y_sq = y.squaredNorm();
+            if (y_sq >= 1) return;
+            hits |= std::uint64_t(1) << e;
+            const Real y_len = std::sqrt(y_sq);
+            const Real depth = y_len > Real(1e-6) ? (xp - f.center).norm() * (1 / y_len - 1) : f.radii_m.minCoeff();
+            r.max_penetration_m = std::max(r.max_penetration_m, depth);
+        };
+        for_each_bit(last, detect);          // temporal coherence: last substep's contacts first
+        for_each_bit(list & ~last, detect);  // then the rest of the pre-collision list
+        if (detected) (*detected)[pi] = hits;
+        last_collided[pi] = hits;
+        if (hits == 0) continue;
+
+        Vec3 vp = v.col(p);
+        auto respond = [&](int e) {
+            const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+            const Vec3 y = to_unit_sphere(f, xp);
+            if (y.squaredNorm() >= 1) return false;
+            push_out(f, y, xp, vp);
+            ++r.collisions;
+            return true;
+        };
+        for_each_bit(hits & last, respond);
+        for_each_bit(hits & ~last, respond);
+        if (std::popcount(list) > 1) {
+            bool moved = true;
+            for (int round = 0; round < max_retest_rounds && moved; ++round) {
+                moved = false;
+                for_each_bit(list, [&](int e) {
+                    ++r.tests;
+                    moved = respond(e) || moved;
+                });
+            }
+            if (moved) ++r.unresolved;
+        }
+        x.col(p) = xp;
+        v.col(p) = vp;
+    }
+    return r;
+}
+
+DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass, std::span<const EllipsoidFrame> frames) {
+    DetectedPairs out(static_cast<std::size_t>(x.cols()), 0);
+    for (Eigen::Index p = 0; p < x.cols(); ++p) {
+        if (inv_mass[p] == 0) continue;
+        for (std::size_t e = 0; e < frames.size() && e < 64; ++e)
+            if (frames[e].active && to_unit_sphere(frames[e], x.col(p)).squaredNorm() < 1)
+                out[static_cast<std::size_t>(p)] |= std::uint64_t(1) << e;
+    }
+    return out;
+}
+
+CollisionResult collide_garment(Garment& g, DetectedPairs* detected) {
+    const Eigen::Index n = g.x.cols();
+    const std::size_t e_count = g.frames.size();
+    const std::vector<std::uint64_t>* lists = nullptr;
+
+    if (g.collision == CollisionMode::candidate_lists) {
+        const Affine3 anchor = anchor_frame(g);
+        const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
+        const Vec3 anchor_origin = anchor.translation();
+        const Real margin = g.material.candidate_margin_m;
+        bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
+                     g.candidates.size() == static_cast<std::size_t>(n);
+        Real frame_move = 0;
+        for (std::size_t e = 0; valid && e < e_count; ++e) {
+            const Affine3& then = g.list_anchor_frames[e];
+            const bool was_active = then.linear().squaredNorm() > 0;
+            if (was_active != g.frames[e].active) { valid = false; break; }
+            if (!was_active) continue;
+            const Affine3 world = unit_to_world(g.frames[e]);
+            const Vec3 c = to_anchor * (world.translation() - anchor_origin);
+            const Mat3 l = to_anchor * world.linear();
+            frame_move = std::max(frame_move, (c - then.translation()).norm() + (l - then.linear()).norm());
+        }
+        if (valid && frame_move > margin) valid = false;
+        if (valid) {
+            const Real budget_sq = (margin - frame_move) * (margin - frame_move);
+            for (Eigen::Index p = 0; p < n; ++p) {
+                if ((to_anchor * (g.x.col(p) - anchor_origin) - g.list_anchor_x.col(p)).squaredNorm() > budget_sq) {
+                    valid = false;
+                    break;
+                }
+            }
+        }
+        if (!valid) {
+            const std::uint64_t tests = build_candidate_lists(g.x, g.frames, margin, g.candidates);
+            g.list_anchor_x.resize(3, n);
+            for (Eigen::Index p = 0; p < n; ++p) g.list_anchor_x.col(p) = to_anchor * (g.x.col(p) - anchor_origin);
+            g.list_anchor_frames.resize(e_count);
+            for (std::size_t e = 0; e < e_count; ++e) {
+                Affine3& then = g.list_anchor_frames[e];
+                if (!g.frames[e].active) {
+                    then.matrix().setZero();
+                    continue;
+                }
+                const Affine3 world = unit_to_world(g.frames[e]);
+                then.setIdentity();
+                then.linear() = to_anchor * world.linear();
+                then.translation() = to_anchor * (world.translation() - anchor_origin);
+            }
+            g.lists_valid = true;
+            ++g.counters.list_rebuilds;
+            g.counters.list_rebuild_tests += tests;
+            g.counters.frame_list_rebuild_tests += tests;
+        }
+        lists = &g.candidates;
+    }
+
+    const CollisionResult r = collide_particles(g.x, g.v, g.inv_mass, g.frames, lists, g.last_collided, detected);
+    g.counters.frame_collision_tests += r.tests;
+    g.counters.collision_tests += r.tests;
+    g.counters.frame_collisions += r.collisions;
+    g.counters.collisions += r.collisions;
+    g.counters.max_penetration_m = std::max(g.counters.max_penetration_m, r.max_penetration_m);
+    return r;
+}
+
+}  // namespace drape

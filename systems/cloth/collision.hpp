@@ -1,0 +1,76 @@
+// Particle-ellipsoid collision with candidate lists and temporal coherence (method §5).
+//
+// Conventions: only particles are tested, never triangles; each test maps the particle into
+// the ellipsoid's unit-sphere frame, y = diag(1/r) R^T (x - c), and asks |y| < 1.
+//
+// Step order of one substep (cloth collision system):
+//   1. Candidate lists (spatial locality): each particle keeps a bit set of the ellipsoids
+//      it can touch. A list holds every ellipsoid within `margin` of the particle when it
+//      was built (|y| < 1 + margin / r_min). The lists stay exact while
+//      max particle displacement + max ellipsoid displacement <= margin, both measured in
+//      the anchor's rigid frame since the build (an ellipsoid's displacement is bounded by
+//      |dc| + |dL|_F of its unit-sphere map), so they are rebuilt only when that bound is
+//      spent. Within that bound no ellipsoid outside a list can contain the particle.
+//   2. Detection: ellipsoids the particle collided with last substep are tested first
+//      (temporal coherence), then the rest of its list; brute force tests every ellipsoid.
+//   3. Response for each hit, last-collided first: move the particle to where the line
+//      from the centre through it meets the surface, x = c + (x - c) / |y|, and remove the
+//      velocity component along the surface normal relative to the surface's own motion
+//      (the ellipsoid is inelastic). Overlapping ellipsoids can push a particle into a
+//      neighbour, so the particle's list is re-tested until it is outside all of them.
+// Pinned particles are skipped: they are on the skin by construction (method §3.5).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "components/garment.hpp"
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// Unit-sphere coordinates of x in the ellipsoid's frame.
+[[nodiscard]] inline Vec3 to_unit_sphere(const EllipsoidFrame& f, const Vec3& x) { return f.to_unit * (x - f.center); }
+
+/// Distance the centre-line response would move `x` out of the ellipsoid (0 when outside), m.
+[[nodiscard]] Real penetration_depth(const EllipsoidFrame& f, const Vec3& x);
+
+/// Moves x onto the surface along the centre line and removes the normal velocity
+/// relative to the surface (method §5). `y` = to_unit_sphere(f, x), |y| < 1.
+void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v);
+
+/// Bit set of the active frames.
+[[nodiscard]] std::uint64_t active_mask(std::span<const EllipsoidFrame> frames);
+
+/// Rebuilds every particle's candidate list (step 1). Returns the tests done.
+std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin_m,
+                                    std::vector<std::uint64_t>& candidates);
+
+/// What a collision pass did.
+struct CollisionResult {
+    std::uint64_t tests = 0;          ///< Unit-sphere tests (detection and re-tests).
+    std::uint64_t collisions = 0;     ///< Contacts resolved.
+    std::uint64_t unresolved = 0;     ///< Particles still inside an ellipsoid after the re-test cap.
+    Real max_penetration_m = 0;       ///< Deepest detected penetration, before response.
+};
+
+/// Optional record of detections (for tests): one bit set per particle of the ellipsoids
+/// found to contain it at the start of the pass, before any response.
+using DetectedPairs = std::vector<std::uint64_t>;
+
+/// Steps 2-3 for particles [0, cols). `candidates` null = brute force. `last_collided`
+/// is read (tested first) and rewritten.
+CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
+                                  std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
+                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr);
+
+/// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
+[[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,
+                                               std::span<const EllipsoidFrame> frames);
+
+/// Whole garment: checks the lists' displacement bound (rebuilding when spent), then
+/// collides in the garment's mode and adds to its counters. Frames must be current.
+CollisionResult collide_garment(Garment& garment, DetectedPairs* detected = nullptr);
+
+}  // namespace drape

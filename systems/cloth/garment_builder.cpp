@@ -1,0 +1,494 @@
+// Garment builders (method §3.2, §3.5); placement rules in garment_builder.hpp.
+#include "systems/cloth/garment_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/skeleton.hpp"
+#include "components/skinned_mesh.hpp"
+#include "components/transform.hpp"
+#include "systems/cloth/body.hpp"
+#include "systems/cloth/collision.hpp"
+#include "systems/cloth/garment_step.hpp"
+#include "systems/cloth/pins.hpp"
+
+namespace drape {
+namespace {
+
+std::string field(std::string_view prefix, std::string_view name) {
+    return std::string(prefix) + "." + std::string(name);
+}
+
+bool finite_positive(Real v) { return std::isfinite(v) && v > 0; }
+
+Result<void> validate_grid(std::string_view p, int lines, int per_line, int stride, bool closed) {
+    if (lines < 2 || lines > 4096) return fail(field(p, "warp_lines") + ": must be in [2, 4096], got " + std::to_string(lines));
+    if (per_line < 2 || per_line > 4096)
+        return fail(field(p, "particles_per_line") + ": must be in [2, 4096], got " + std::to_string(per_line));
+    if (stride < 1 || stride >= lines)
+        return fail(field(p, "weft_stride") + ": must be in [1, warp_lines), got " + std::to_string(stride));
+    if (closed && lines % stride != 0)
+        return fail(field(p, "warp_lines") + ": must be a multiple of " + field(p, "weft_stride") + " (" +
+                    std::to_string(lines) + " % " + std::to_string(stride) + " != 0)");
+    if (!closed && (lines - 1) % stride != 0)
+        return fail(field(p, "warp_lines") + ": warp_lines - 1 must be a multiple of " + field(p, "weft_stride") +
+                    " so that the last line is layer 1 (" + std::to_string(lines - 1) + " % " + std::to_string(stride) +
+                    " != 0)");
+    return {};
+}
+
+Result<void> validate_tube(std::string_view p, int lines, int per_line, int stride, Real length, Real flare_deg,
+                           Real ease, Real height_fraction, std::string_view height_fraction_name, Real height_m,
+                           std::string_view height_m_name, Real torso_fraction, int fitting_rows,
+                           const ClothMaterial& material) {
+    if (auto ok = validate_grid(p, lines, per_line, stride, true); !ok) return ok;
+    if (!finite_positive(length)) return fail(field(p, "length_m") + ": must be > 0, got " + std::to_string(length));
+    if (!std::isfinite(flare_deg) || flare_deg < 0 || flare_deg > 80)
+        return fail(field(p, "flare_deg") + ": must be in [0, 80], got " + std::to_string(flare_deg));
+    if (!std::isfinite(ease) || ease < 0 || ease > 1)
+        return fail(field(p, "ease_m") + ": must be in [0, 1], got " + std::to_string(ease));
+    if (!std::isfinite(height_fraction) || height_fraction <= 0 || height_fraction >= 1)
+        return fail(field(p, height_fraction_name) + ": must be in (0, 1), got " + std::to_string(height_fraction));
+    if (!std::isfinite(height_m) || height_m < 0)
+        return fail(field(p, height_m_name) + ": must be >= 0 (0 = from the fraction), got " + std::to_string(height_m));
+    if (!finite_positive(torso_fraction))
+        return fail(field(p, "torso_radius_fraction") + ": must be > 0, got " + std::to_string(torso_fraction));
+    if (fitting_rows < 1 || fitting_rows >= per_line)
+        return fail(field(p, "fitting_rows") + ": must be in [1, particles_per_line), got " + std::to_string(fitting_rows));
+    return validate(material, field(p, "material"));
+}
+
+// Particle-order positions from grid-order positions.
+Matrix3X to_particle_order(const GarmentTopology& t, const Matrix3X& grid_positions) {
+    Matrix3X x(3, grid_positions.cols());
+    for (Eigen::Index k = 0; k < grid_positions.cols(); ++k) x.col(t.grid[static_cast<std::size_t>(k)]) = grid_positions.col(k);
+    return x;
+}
+
+Garment make_instance(std::shared_ptr<const GarmentTopology> topology, Matrix3X x, const ClothMaterial& material,
+                      ClothModel model, CollisionMode collision, const Vec3& color) {
+    Garment g;
+    const Eigen::Index n = x.cols();
+    g.topology = std::move(topology);
+    g.x = std::move(x);
+    g.v = Matrix3X::Zero(3, n);
+    g.inv_mass = VectorX::Constant(n, Real(n) / material.mass_kg);
+    g.material = material;
+    g.model = model;
+    g.collision = collision;
+    g.color = color;
+    return g;
+}
+
+// Vertical half extent of an ellipsoid (its axis-aligned box).
+Real half_height(const EllipsoidFrame& f) { return (f.rotation * f.radii_m.asDiagonal()).row(1).norm(); }
+
+// Distance along the horizontal ray o + t d at which it leaves the ellipsoid (<0: misses).
+Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
+    const Vec3 oo = f.to_unit * (o - f.center);
+    const Vec3 dd = f.to_unit * d;
+    const Real a = dd.squaredNorm(), b = 2 * oo.dot(dd), c = oo.squaredNorm() - 1;
+    const Real disc = b * b - 4 * a * c;
+    if (disc < 0 || a <= 0) return -1;
+    return (-b + std::sqrt(disc)) / (2 * a);
+}
+
+struct TubeShape {
+    std::string_view name;
+    int lines, per_line, stride;
+    Real length_m, flare_rad, ease_m, height_fraction, height_m, torso_fraction;
+    int fitting_rows;
+    ClothMaterial material;
+    ClothModel model;
+    CollisionMode collision;
+    Vec3 color;
+};
+
+// Binds pinned particle p (world position x) to the body (method §3.5).
+PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
+                    std::span<const EllipsoidFrame> frames, std::uint32_t p, const Vec3& x) {
+    PinBinding pin;
+    pin.particle = p;
+    // Nearest collider in unit-sphere terms (the body part the pin sits on).
+    std::size_t nearest = 0;
+    Real best = std::numeric_limits<Real>::infinity();
+    for (std::size_t e = 0; e < frames.size(); ++e) {
+        if (!frames[e].active) continue;
+        const Real d = to_unit_sphere(frames[e], x).norm();
+        if (d < best) { best = d; nearest = e; }
+    }
+
+    const auto* skeleton = registry.try_get<Skeleton>(character);
+    const auto* transform = registry.try_get<Transform>(character);
+    const bool can_skin = skeleton && skeleton->asset && !skeleton->skinning.empty() &&
+                          skeleton->skinning.size() == skeleton->asset->size();
+    if (can_skin) {
+        const Affine3 to_model = transform ? transform->matrix().inverse() : Affine3::Identity();
+        const Vec3 model = to_model * x;
+        Vec4i bones = Vec4i::Zero();
+        Vec4 weights = Vec4::Zero();
+        bool found = false;
+        const auto* skin = registry.try_get<SkinnedMesh>(character);
+        if (skin && skin->mesh && skin->mesh->vertex_count() > 0) {
+            // Weights of the nearest skin vertex, at the current pose (linear blend skinning).
+            const MeshAsset& mesh = *skin->mesh;
+            Real best_d = std::numeric_limits<Real>::infinity();
+            for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+                const Eigen::Index vi = static_cast<Eigen::Index>(v);
+                const Vec4i b = mesh.bone_indices.col(vi);
+                const Vec4 w = mesh.bone_weights.col(vi);
+                bool ok = true;
+                for (int i = 0; i < 4; ++i)
+                    if (w[i] != 0 && (b[i] < 0 || static_cast<std::size_t>(b[i]) >= skeleton->skinning.size())) ok = false;
+                if (!ok) continue;
+                const Vec3 posed = blend_skinning(skeleton->skinning, b, w) * Vec3(mesh.bind_positions.col(vi));
+                const Real d = (posed - model).squaredNorm();
+                if (d < best_d) { best_d = d; bones = b; weights = w; found = true; }
+            }
+        }
+        if (!found && !colliders.empty()) {
+            const auto* c = registry.try_get<EllipsoidCollider>(colliders[nearest]);
+            if (c && c->bone >= 0 && static_cast<std::size_t>(c->bone) < skeleton->skinning.size()) {
+                bones = Vec4i(c->bone, 0, 0, 0);
+                weights = Vec4(1, 0, 0, 0);
+                found = true;
+            }
+        }
+        if (found) {
+            const Affine3 m = blend_skinning(skeleton->skinning, bones, weights);
+            if (std::abs(m.linear().determinant()) > Real(1e-8)) {
+                pin.kind = PinKind::skinned;
+                pin.bones = bones;
+                pin.weights = weights;
+                pin.local = m.inverse() * model;
+                return pin;
+            }
+        }
+    }
+    if (!colliders.empty() && std::isfinite(best)) {
+        pin.kind = PinKind::collider;
+        pin.collider = static_cast<std::int32_t>(nearest);
+        pin.local = unit_to_world(frames[nearest]).inverse() * x;
+        return pin;
+    }
+    pin.kind = PinKind::world;
+    pin.local = x;
+    return pin;
+}
+
+// Pins `rows` rows, pushes the rest out of the colliders, records the rest shape, and
+// adds the garment to the registry.
+Result<Entity> finish(Registry& registry, Garment g, int rows) {
+    const GarmentTopology& t = *g.topology;
+    update_frames(registry, g, 1);
+    for (std::uint32_t line = 0; line < t.warp_lines; ++line) {
+        for (std::uint32_t row = 0; row < static_cast<std::uint32_t>(rows); ++row) {
+            const std::uint32_t p = t.grid[line * t.particles_per_line + row];
+            g.inv_mass[p] = 0;
+            g.pins.push_back(bind_pin(registry, g.body, g.colliders, g.frames, p, g.x.col(p)));
+        }
+    }
+    for (const PinBinding& pin : g.pins)
+        if (auto at = evaluate_pin(registry, g, pin)) g.x.col(pin.particle) = *at;
+    prepare_garment(g);
+    std::vector<std::uint64_t> last;
+    for (int pass = 0; pass < 4; ++pass) collide_particles(g.x, g.v, g.inv_mass, g.frames, nullptr, last);
+    g.v.setZero();
+    const Affine3 anchor = anchor_frame(g);
+    g.rest_local = anchor.inverse(Eigen::Isometry) * g.x;
+    update_pin_targets(registry, g, true);
+    if (!g.x.allFinite()) return fail(std::string("garment placement produced non-finite positions"));
+    const Entity e = registry.create();
+    registry.emplace<Garment>(e, std::move(g));
+    return e;
+}
+
+Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape& s) {
+    const std::string p(s.name);
+    if (!registry.valid(character)) return fail(p + ": the character entity is not alive");
+    const std::vector<Entity> colliders = character_colliders(registry, character);
+    if (colliders.empty()) return fail(p + ": the character has no ellipsoid colliders");
+    if (colliders.size() > 64) return fail(p + ": the character has " + std::to_string(colliders.size()) +
+                                           " colliders; a garment handles at most 64");
+    std::vector<EllipsoidFrame> frames;
+    bool placed = false;
+    for (Entity e : colliders) {
+        const auto& c = registry.get<EllipsoidCollider>(e);
+        placed = placed || c.initialised;
+        frames.push_back(make_ellipsoid_frame(c.world));
+    }
+    if (!placed) return fail(p + ": the character's colliders have not been placed yet (run the collider system once)");
+
+    // Body height and axis from the colliders.
+    Real bottom = std::numeric_limits<Real>::infinity(), top = -bottom;
+    Vec3 axis = Vec3::Zero();
+    int active = 0;
+    for (const EllipsoidFrame& f : frames) {
+        if (!f.active) continue;
+        bottom = std::min(bottom, f.center.y() - half_height(f));
+        top = std::max(top, f.center.y() + half_height(f));
+        axis += f.center;
+        ++active;
+    }
+    if (active == 0) return fail(p + ": the character's colliders are degenerate (zero radii)");
+    axis /= Real(active);
+    const Real height = top - bottom;
+    const Real ring_y = bottom + (s.height_m > 0 ? s.height_m : s.height_fraction * height);
+    const Vec3 origin(axis.x(), ring_y, axis.z());
+
+    // Outline colliders: cross the ring height, near the axis.
+    std::vector<std::size_t> outline;
+    for (std::size_t e = 0; e < frames.size(); ++e) {
+        const EllipsoidFrame& f = frames[e];
+        if (!f.active || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
+        const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
+        if (off.norm() > s.torso_fraction * height) continue;
+        outline.push_back(e);
+    }
+    if (outline.empty())
+        return fail(p + ": no collider crosses the ring height " + std::to_string(ring_y) + " m near the body axis");
+
+    const int n = s.lines, m = s.per_line;
+    const Real step = s.length_m / Real(m - 1);
+    Matrix3X grid(3, n * m);
+    for (int line = 0; line < n; ++line) {
+        const Real theta = Real(2) * std::numbers::pi_v<Real> * Real(line) / Real(n);
+        const Vec3 d(std::sin(theta), 0, std::cos(theta));
+        Real r = -1;
+        for (std::size_t e : outline) r = std::max(r, ray_exit(frames[e], origin, d));
+        if (r <= 0) return fail(p + ": the body outline at the ring height does not surround the axis");
+        r += s.ease_m;
+        for (int row = 0; row < m; ++row) {
+            const Real along = step * Real(row);
+            grid.col(line * m + row) =
+                origin + d * (r + along * std::sin(s.flare_rad)) - Vec3::UnitY() * (along * std::cos(s.flare_rad));
+        }
+    }
+    auto topology = build_grid_topology(n, m, s.stride, true, grid, s.name);
+    if (!topology) return std::unexpected(topology.error());
+    Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
+    g.body = character;
+    g.colliders = colliders;
+    // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
+    std::size_t anchor = outline.front();
+    for (std::size_t e : outline)
+        if ((frames[e].center - origin).norm() < (frames[anchor].center - origin).norm()) anchor = e;
+    g.anchor = static_cast<std::int32_t>(anchor);
+    return finish(registry, std::move(g), s.fitting_rows);
+}
+
+}  // namespace
+
+Result<void> validate(const ClothMaterial& m, std::string_view p) {
+    if (!finite_positive(m.mass_kg)) return fail(field(p, "mass_kg") + ": must be > 0, got " + std::to_string(m.mass_kg));
+    if (!finite_positive(m.stretch_k_N_m))
+        return fail(field(p, "stretch_k_N_m") + ": must be > 0, got " + std::to_string(m.stretch_k_N_m));
+    if (!std::isfinite(m.shear_k_N_m) || m.shear_k_N_m < 0)
+        return fail(field(p, "shear_k_N_m") + ": must be >= 0, got " + std::to_string(m.shear_k_N_m));
+    if (!std::isfinite(m.bend_k_N_m) || m.bend_k_N_m < 0)
+        return fail(field(p, "bend_k_N_m") + ": must be >= 0, got " + std::to_string(m.bend_k_N_m));
+    if (!std::isfinite(m.drag_N_s_m) || m.drag_N_s_m < 0)
+        return fail(field(p, "drag_N_s_m") + ": must be >= 0, got " + std::to_string(m.drag_N_s_m));
+    if (!std::isfinite(m.strain_limit) || m.strain_limit <= 0 || m.strain_limit > 10)
+        return fail(field(p, "strain_limit") + ": must be in (0, 10], got " + std::to_string(m.strain_limit));
+    if (m.strain_iterations < 0 || m.strain_iterations > 100)
+        return fail(field(p, "strain_iterations") + ": must be in [0, 100], got " + std::to_string(m.strain_iterations));
+    if (!finite_positive(m.candidate_margin_m))
+        return fail(field(p, "candidate_margin_m") + ": must be > 0, got " + std::to_string(m.candidate_margin_m));
+    return {};
+}
+
+Result<void> validate(const SkirtParams& s) {
+    return validate_tube("skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
+                         s.waist_height_fraction, "waist_height_fraction", s.waist_height_m, "waist_height_m",
+                         s.torso_radius_fraction, s.fitting_rows, s.material);
+}
+
+Result<void> validate(const DressParams& s) {
+    return validate_tube("dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
+                         s.shoulder_height_fraction, "shoulder_height_fraction", s.shoulder_height_m,
+                         "shoulder_height_m", s.torso_radius_fraction, s.fitting_rows, s.material);
+}
+
+Result<void> validate(const RectangleParams& r) {
+    if (auto ok = validate_grid("rectangle", r.warp_lines, r.particles_per_line, r.weft_stride, false); !ok) return ok;
+    if (!finite_positive(r.width_m)) return fail("rectangle.width_m: must be > 0, got " + std::to_string(r.width_m));
+    if (!finite_positive(r.length_m)) return fail("rectangle.length_m: must be > 0, got " + std::to_string(r.length_m));
+    if (!r.origin.allFinite()) return fail("rectangle.origin: must be finite");
+    return validate(r.material, "rectangle.material");
+}
+
+Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(int lines_in, int per_line_in, int stride_in,
+                                                                   bool closed, const Matrix3X& pos,
+                                                                   std::string_view p) {
+    if (auto ok = validate_grid(p, lines_in, per_line_in, stride_in, closed); !ok) return std::unexpected(ok.error());
+    const auto n = static_cast<std::uint32_t>(lines_in), m = static_cast<std::uint32_t>(per_line_in),
+               stride = static_cast<std::uint32_t>(stride_in);
+    if (pos.cols() != static_cast<Eigen::Index>(n * m))
+        return fail(std::string(p) + ": " + std::to_string(pos.cols()) + " positions for a " + std::to_string(n) + " x " +
+                    std::to_string(m) + " grid");
+    if (!pos.allFinite()) return fail(std::string(p) + ": non-finite rest positions");
+
+    auto t = std::make_shared<GarmentTopology>();
+    t->warp_lines = n;
+    t->particles_per_line = m;
+    t->weft_stride = stride;
+    t->closed = closed;
+    const auto is_layer1 = [&](std::uint32_t line) { return line % stride == 0; };
+    const auto gi = [&](std::uint32_t line, std::uint32_t row) { return line * m + row; };
+
+    // Particle order: layer-1 lines first (one contiguous block to integrate), then layer 2.
+    t->grid.assign(n * m, 0);
+    t->layer.assign(n * m, 0);
+    std::uint32_t next = 0;
+    for (int pass = 1; pass <= 2; ++pass)
+        for (std::uint32_t line = 0; line < n; ++line)
+            if (is_layer1(line) == (pass == 1))
+                for (std::uint32_t row = 0; row < m; ++row) {
+                    t->grid[gi(line, row)] = next;
+                    t->layer[next++] = static_cast<std::uint8_t>(pass);
+                }
+    t->layer1_count = static_cast<std::uint32_t>(std::count(t->layer.begin(), t->layer.end(), 1));
+    t->layer1_mass_scale = Real(n * m) / Real(t->layer1_count);
+
+    const auto at = [&](std::uint32_t line, std::uint32_t row) { return t->grid[gi(line, row)]; };
+    const auto rest = [&](std::uint32_t a_line, std::uint32_t a_row, std::uint32_t b_line, std::uint32_t b_row) {
+        return (pos.col(gi(b_line, b_row)) - pos.col(gi(a_line, a_row))).norm();
+    };
+    const std::uint32_t weft_lines = closed ? n : n - 1;  // line -> line + 1 pairs
+    std::string degenerate;
+    const auto add = [&](SpringPhase& phase, std::uint32_t al, std::uint32_t ar, std::uint32_t bl, std::uint32_t br) {
+        const Real r = rest(al, ar, bl, br);
+        if (!(r > Real(1e-6))) degenerate = "two neighbouring particles coincide at rest";
+        phase.add(at(al, ar), at(bl, br), r);
+    };
+    // Warp springs line by line from the fitting zone (row 0) outward.
+    for (std::uint32_t line = 0; line < n; ++line)
+        for (std::uint32_t row = 0; row + 1 < m; ++row) add(is_layer1(line) ? t->warp1 : t->warp2, line, row, line, row + 1);
+    for (std::uint32_t row = 0; row < m; ++row)
+        for (std::uint32_t line = 0; line < weft_lines; ++line) add(t->weft, line, row, (line + 1) % n, row);
+    for (std::uint32_t line = 0; line < weft_lines; ++line)
+        for (std::uint32_t row = 0; row + 1 < m; ++row) {
+            add(t->shear, line, row, (line + 1) % n, row + 1);
+            add(t->shear, (line + 1) % n, row, line, row + 1);
+        }
+    for (std::uint32_t line = 0; line < n; ++line)
+        for (std::uint32_t row = 0; row + 2 < m; ++row) add(t->bend, line, row, line, row + 2);
+    const std::uint32_t bend_lines = closed ? n : (n >= 2 ? n - 2 : 0);
+    if (n > 2)
+        for (std::uint32_t row = 0; row < m; ++row)
+            for (std::uint32_t line = 0; line < bend_lines; ++line) add(t->bend, line, row, (line + 2) % n, row);
+    if (!degenerate.empty()) return fail(std::string(p) + ": " + degenerate);
+
+    // Weft placement of layer 2 (method §4.2).
+    for (std::uint32_t line = 0; line < n; ++line) {
+        if (is_layer1(line)) continue;
+        const std::uint32_t left = line - line % stride;
+        const std::uint32_t right = (left + stride) % n;
+        for (std::uint32_t row = 0; row < m; ++row) {
+            t->weft_particle.push_back(at(line, row));
+            t->weft_left.push_back(at(left, row));
+            t->weft_right.push_back(at(right, row));
+            t->weft_t.push_back(Real(line % stride) / Real(stride));
+        }
+    }
+    // Normal stencil of every layer-1 particle, in particle order.
+    t->normal_up.resize(t->layer1_count);
+    t->normal_down.resize(t->layer1_count);
+    t->normal_prev.resize(t->layer1_count);
+    t->normal_next.resize(t->layer1_count);
+    for (std::uint32_t line = 0; line < n; line += stride) {
+        const std::uint32_t prev = closed ? (line + n - stride) % n : (line >= stride ? line - stride : line);
+        const std::uint32_t nxt = closed ? (line + stride) % n : (line + stride < n ? line + stride : line);
+        for (std::uint32_t row = 0; row < m; ++row) {
+            const std::uint32_t i = at(line, row);
+            t->normal_up[i] = at(line, row > 0 ? row - 1 : row);
+            t->normal_down[i] = at(line, row + 1 < m ? row + 1 : row);
+            t->normal_prev[i] = at(prev, row);
+            t->normal_next[i] = at(nxt, row);
+        }
+    }
+    // Render triangles, counter-clockwise seen from the side the normals point to.
+    for (std::uint32_t line = 0; line < weft_lines; ++line)
+        for (std::uint32_t row = 0; row + 1 < m; ++row) {
+            const std::uint32_t p00 = at(line, row), p01 = at(line, row + 1);
+            const std::uint32_t p10 = at((line + 1) % n, row), p11 = at((line + 1) % n, row + 1);
+            t->triangles.insert(t->triangles.end(), {p00, p01, p10, p10, p01, p11});
+        }
+    return std::shared_ptr<const GarmentTopology>(std::move(t));
+}
+
+std::vector<Entity> character_colliders(Registry& registry, Entity character) {
+    std::vector<Entity> out;
+    registry.view<EllipsoidCollider>().each([&](Entity e, EllipsoidCollider& c) {
+        if (c.character == character) out.push_back(e);
+    });
+    std::sort(out.begin(), out.end(), [](Entity a, Entity b) { return a.index < b.index; });
+    return out;
+}
+
+Result<Entity> attach_skirt(Registry& registry, Entity character, const SkirtParams& s) {
+    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character,
+                       TubeShape{"skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
+                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.waist_height_fraction,
+                                 s.waist_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
+                                 s.collision, s.color});
+}
+
+Result<Entity> attach_dress(Registry& registry, Entity character, const DressParams& s) {
+    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character,
+                       TubeShape{"dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
+                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.shoulder_height_fraction,
+                                 s.shoulder_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
+                                 s.collision, s.color});
+}
+
+Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity> colliders) {
+    if (auto ok = validate(r); !ok) return std::unexpected(ok.error());
+    if (colliders.size() > 64) return fail("rectangle: at most 64 colliders, got " + std::to_string(colliders.size()));
+    const int n = r.warp_lines, m = r.particles_per_line;
+    Matrix3X grid(3, n * m);
+    for (int line = 0; line < n; ++line)
+        for (int row = 0; row < m; ++row) {
+            const Real across = r.width_m * Real(line) / Real(n - 1);
+            const Real down = r.length_m * Real(row) / Real(m - 1);
+            grid.col(line * m + row) = r.origin + Vec3(across, r.hanging ? -down : 0, r.hanging ? 0 : down);
+        }
+    auto topology = build_grid_topology(n, m, r.weft_stride, false, grid, "rectangle");
+    if (!topology) return std::unexpected(topology.error());
+    Garment g = make_instance(*topology, to_particle_order(**topology, grid), r.material, r.model, r.collision, r.color);
+    g.colliders.assign(colliders.begin(), colliders.end());
+    if (r.pin_top_row)
+        for (int line = 0; line < n; ++line) {
+            const std::uint32_t p = (*topology)->grid[static_cast<std::size_t>(line * m)];
+            g.inv_mass[p] = 0;
+            PinBinding pin;
+            pin.particle = p;
+            pin.kind = PinKind::world;
+            pin.local = g.x.col(p);
+            g.pins.push_back(pin);
+        }
+    g.rest_local = g.x;
+    prepare_garment(g);
+    return g;
+}
+
+Result<Entity> attach_rectangle(Registry& registry, const RectangleParams& r, std::span<const Entity> colliders) {
+    auto g = make_rectangle(r, colliders);
+    if (!g) return std::unexpected(g.error());
+    const Entity e = registry.create();
+    registry.emplace<Garment>(e, std::move(*g));
+    return e;
+}
+
+void reset_garment(Registry& registry, Entity garment) {
+    if (Garment* g = registry.try_get<Garment>(garment)) reset_garment_state(registry, *g);
+}
+
+}  // namespace drape

@@ -1,0 +1,111 @@
+// Garment builders: a skirt and a dress placed around a character from its ellipsoid
+// colliders, and a flat rectangle for tests (method §3.2 grid, §3.5 fitting zones).
+//
+// Placement (skirt and dress): the character's colliders are the EllipsoidCollider
+// entities whose `character` is that entity, in entity order, and must have been placed
+// (the collider system has run, or a test set `world` and `initialised`). The body's
+// height is the vertical extent of its colliders; the body axis is vertical through the
+// mean of their centres. At the ring height (the waist for a skirt, the shoulders for a
+// dress) the outline of the colliders that cross that height and lie near the axis (not
+// arms or hands) is sampled along each warp line's direction; the garment is a truncated
+// cone from that outline (plus ease), flaring outward, and is then pushed out of every
+// collider. The top `fitting_rows` rows are pinned (method §3.5):
+//   - skinned to the skin when the character has a Skeleton with skinning matrices
+//     (weights of the nearest skin vertex when it has a SkinnedMesh, else its collider's
+//     bone), so the pins follow linear blend skinning like the body mesh;
+//   - otherwise bound rigidly to the nearest collider (analytic bodies).
+// Parameter errors name the field ("skirt.length_m: must be > 0").
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string_view>
+
+#include "components/garment.hpp"
+#include "engine/core/error.hpp"
+#include "engine/core/registry.hpp"
+
+namespace drape {
+
+/// A skirt: a truncated cone hanging from the waist (the fitted hip ellipsoids).
+struct SkirtParams {
+    int warp_lines = 27;              ///< Lines around the body (n); a multiple of weft_stride.
+    int particles_per_line = 31;      ///< Particles down each line (m). 27 x 31 = 837.
+    int weft_stride = 3;              ///< Every weft_stride-th line is layer 1 (method §3.2).
+    Real length_m = Real(0.55);       ///< Along the cone from the waist to the hem.
+    Real flare_deg = Real(18);        ///< Cone half-angle from vertical, [0, 80].
+    Real ease_m = Real(0.01);         ///< Gap between the waist outline and the cloth.
+    Real waist_height_fraction = Real(0.58);  ///< Waist height / body height (used when waist_height_m is 0).
+    Real waist_height_m = 0;          ///< > 0: waist height above the body's lowest point.
+    Real torso_radius_fraction = Real(0.12);  ///< Colliders centred farther than this x height from the axis (arms) are not outline.
+    int fitting_rows = 1;             ///< Rows pinned to the body.
+    ClothMaterial material{};
+    ClothModel model = ClothModel::simplified;
+    CollisionMode collision = CollisionMode::candidate_lists;
+    Vec3 color = Vec3(0.75f, 0.12f, 0.18f);
+};
+
+/// A dress: a tube hanging from the shoulders. The default has 120 x 84 = 10,080 particles.
+struct DressParams {
+    int warp_lines = 120;
+    int particles_per_line = 84;
+    int weft_stride = 3;
+    Real length_m = Real(1.05);
+    Real flare_deg = Real(10);
+    Real ease_m = Real(0.015);
+    Real shoulder_height_fraction = Real(0.80);  ///< Ring height / body height (used when shoulder_height_m is 0).
+    Real shoulder_height_m = 0;
+    Real torso_radius_fraction = Real(0.12);
+    int fitting_rows = 2;
+    ClothMaterial material{.mass_kg = Real(0.6)};
+    ClothModel model = ClothModel::simplified;
+    CollisionMode collision = CollisionMode::candidate_lists;
+    Vec3 color = Vec3(0.15f, 0.3f, 0.7f);
+};
+
+/// A flat rectangle (tests, demos): lines along +X, rows down -Y (hanging) or along +Z (lying).
+struct RectangleParams {
+    int warp_lines = 16;              ///< (warp_lines - 1) must be a multiple of weft_stride.
+    int particles_per_line = 16;
+    int weft_stride = 3;
+    Real width_m = 1;                 ///< Across the lines.
+    Real length_m = 1;                ///< Down each line.
+    Vec3 origin = Vec3(0, 2, 0);      ///< Position of line 0, row 0.
+    bool hanging = true;              ///< true: rows go down -Y; false: rows go along +Z (horizontal sheet).
+    bool pin_top_row = true;          ///< Pin row 0 in world space.
+    ClothMaterial material{.mass_kg = Real(0.1)};
+    ClothModel model = ClothModel::simplified;
+    CollisionMode collision = CollisionMode::candidate_lists;
+    Vec3 color = Vec3(0.8f, 0.8f, 0.8f);
+};
+
+/// Checks parameters; the error names the field.
+[[nodiscard]] Result<void> validate(const SkirtParams& params);
+[[nodiscard]] Result<void> validate(const DressParams& params);
+[[nodiscard]] Result<void> validate(const RectangleParams& params);
+[[nodiscard]] Result<void> validate(const ClothMaterial& material, std::string_view prefix);
+
+/// Cooks a grid topology from rest positions in grid order (column line * m + row).
+[[nodiscard]] Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(
+    int warp_lines, int particles_per_line, int weft_stride, bool closed, const Matrix3X& grid_positions,
+    std::string_view prefix);
+
+/// Skirt on `character` (see the placement rules above). Returns the garment entity.
+[[nodiscard]] Result<Entity> attach_skirt(Registry& registry, Entity character, const SkirtParams& params);
+
+/// Dress on `character`. Returns the garment entity.
+[[nodiscard]] Result<Entity> attach_dress(Registry& registry, Entity character, const DressParams& params);
+
+/// A flat rectangle, pinned in world space, colliding with `colliders` (no body).
+[[nodiscard]] Result<Garment> make_rectangle(const RectangleParams& params, std::span<const Entity> colliders = {});
+[[nodiscard]] Result<Entity> attach_rectangle(Registry& registry, const RectangleParams& params,
+                                              std::span<const Entity> colliders = {});
+
+/// The character's colliders, in entity order (what a garment on it collides with).
+[[nodiscard]] std::vector<Entity> character_colliders(Registry& registry, Entity character);
+
+/// Back to rest around the body at its current place (see reset_garment_state). Does
+/// nothing for an entity without a Garment.
+void reset_garment(Registry& registry, Entity garment);
+
+}  // namespace drape

@@ -1,0 +1,75 @@
+// Fitting-zone pins (method §3.5); conventions in pins.hpp.
+#include "systems/cloth/pins.hpp"
+
+#include <string>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/skeleton.hpp"
+#include "components/transform.hpp"
+
+namespace drape {
+
+Affine3 blend_skinning(const std::vector<Affine3>& skinning, const Vec4i& bones, const Vec4& weights) {
+    Affine3 m;
+    m.matrix().setZero();
+    for (int i = 0; i < 4; ++i) {
+        if (weights[i] == 0) continue;
+        m.matrix() += weights[i] * skinning[static_cast<std::size_t>(bones[i])].matrix();
+    }
+    m.matrix().row(3) << 0, 0, 0, 1;
+    return m;
+}
+
+Result<Vec3> evaluate_pin(const Registry& registry, const Garment& garment, const PinBinding& pin) {
+    switch (pin.kind) {
+        case PinKind::world: return pin.local;
+        case PinKind::collider: {
+            if (pin.collider < 0 || static_cast<std::size_t>(pin.collider) >= garment.colliders.size())
+                return fail("pin " + std::to_string(pin.particle) + ": collider index out of range");
+            const auto* c = registry.try_get<EllipsoidCollider>(garment.colliders[static_cast<std::size_t>(pin.collider)]);
+            if (c == nullptr) return fail("pin " + std::to_string(pin.particle) + ": its collider is gone");
+            return Vec3(c->world * pin.local);
+        }
+        case PinKind::skinned: {
+            const auto* skeleton = registry.try_get<Skeleton>(garment.body);
+            if (skeleton == nullptr) return fail("pin " + std::to_string(pin.particle) + ": the body has no skeleton");
+            for (int i = 0; i < 4; ++i)
+                if (pin.weights[i] != 0 &&
+                    (pin.bones[i] < 0 || static_cast<std::size_t>(pin.bones[i]) >= skeleton->skinning.size()))
+                    return fail("pin " + std::to_string(pin.particle) + ": bone " + std::to_string(pin.bones[i]) +
+                                " has no skinning matrix");
+            const Vec3 model = blend_skinning(skeleton->skinning, pin.bones, pin.weights) * pin.local;
+            const auto* transform = registry.try_get<Transform>(garment.body);
+            return transform ? Vec3(transform->matrix() * model) : model;
+        }
+    }
+    return fail("pin: unknown kind");
+}
+
+void update_pin_targets(const Registry& registry, Garment& g, bool snap) {
+    const Eigen::Index n = static_cast<Eigen::Index>(g.pins.size());
+    const bool first = g.pin_target.cols() != n;
+    if (first) {
+        g.pin_target.resize(3, n);
+        for (Eigen::Index i = 0; i < n; ++i) g.pin_target.col(i) = g.x.col(g.pins[static_cast<std::size_t>(i)].particle);
+    }
+    g.pin_previous = g.pin_target;
+    for (Eigen::Index i = 0; i < n; ++i) {
+        if (auto p = evaluate_pin(registry, g, g.pins[static_cast<std::size_t>(i)])) g.pin_target.col(i) = *p;
+    }
+    if (first || snap) g.pin_previous = g.pin_target;
+}
+
+void apply_pins(Garment& g, int substep, int substeps, Real fixed_dt) {
+    const Eigen::Index n = g.pin_target.cols();
+    const bool last = substep + 1 >= substeps;
+    const Real alpha = Real(substep + 1) / Real(substeps);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const std::uint32_t p = g.pins[static_cast<std::size_t>(i)].particle;
+        g.x.col(p) = last ? Vec3(g.pin_target.col(i))
+                          : Vec3((1 - alpha) * g.pin_previous.col(i) + alpha * g.pin_target.col(i));
+        g.v.col(p) = (g.pin_target.col(i) - g.pin_previous.col(i)) / fixed_dt;
+    }
+}
+
+}  // namespace drape

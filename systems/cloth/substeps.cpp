@@ -1,0 +1,63 @@
+// The substep rule (method §3.4); see substeps.hpp.
+#include "systems/cloth/substeps.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "components/ellipsoid_collider.hpp"
+#include "systems/cloth/body.hpp"
+#include "systems/cloth/integrator.hpp"
+
+namespace drape {
+
+int garment_substeps(const Registry& registry, Garment& g, double fixed_dt, const ClothSolverSettings& s) {
+    if (!g.topology) return 1;
+    if (!g.stability_valid || !(g.cached_material == g.material)) {
+        g.stable_step_s[0] = stable_step_s(*g.topology, g.material, g.inv_mass, ClothModel::simplified);
+        g.stable_step_s[1] = stable_step_s(*g.topology, g.material, g.inv_mass, ClothModel::classic);
+        g.cached_material = g.material;
+        g.stability_valid = true;
+    }
+    const double cap = std::max(1, s.max_substeps);
+    const double h_stable = double(g.stable_step_s[g.model == ClothModel::simplified ? 0 : 1]) * s.stability_safety;
+    const double stability = std::isfinite(h_stable) && h_stable > 0 ? std::ceil(fixed_dt / h_stable) : cap;
+
+    // Fastest collider surface the garment can touch, relative to its anchor.
+    double speed = 0;
+    const EllipsoidCollider* anchor = g.anchor >= 0 && static_cast<std::size_t>(g.anchor) < g.colliders.size()
+        ? registry.try_get<EllipsoidCollider>(g.colliders[static_cast<std::size_t>(g.anchor)]) : nullptr;
+    std::uint64_t reach = ~std::uint64_t(0);
+    if (g.collision == CollisionMode::candidate_lists && g.lists_valid) {
+        reach = 0;
+        for (std::uint64_t c : g.candidates) reach |= c;
+    }
+    const Vec3 anchor_c = anchor ? Vec3(anchor->world.translation()) : Vec3::Zero();
+    for (std::size_t e = 0; e < g.colliders.size() && e < 64; ++e) {
+        if (!(reach >> e & 1)) continue;
+        const auto* c = registry.try_get<EllipsoidCollider>(g.colliders[e]);
+        if (c == nullptr) continue;
+        const Vec3 center = c->world.translation();
+        Vec3 dv = c->velocity_m_s;
+        Vec3 dw = c->angular_velocity_rad_s;
+        if (anchor) {
+            dv -= anchor->velocity_m_s + anchor->angular_velocity_rad_s.cross(center - anchor_c);
+            dw -= anchor->angular_velocity_rad_s;
+        }
+        const Real r_max = c->world.linear().colwise().norm().maxCoeff();
+        const double u = double(dv.norm()) + double(dw.norm()) * double(r_max);
+        if (std::isfinite(u)) speed = std::max(speed, u);
+    }
+    const double motion = s.max_surface_travel_m > 0 ? std::ceil(fixed_dt * speed / s.max_surface_travel_m) : 1;
+
+    g.counters.substeps_stability = static_cast<int>(std::clamp(stability, 1.0, cap));
+    g.counters.substeps_motion = static_cast<int>(std::clamp(motion, 1.0, cap));
+    return std::max(g.counters.substeps_stability, g.counters.substeps_motion);
+}
+
+int cloth_substeps(Registry& registry, double fixed_dt, const ClothSolverSettings& s) {
+    int n = 1;
+    registry.view<Garment>().each([&](Entity, Garment& g) { n = std::max(n, garment_substeps(registry, g, fixed_dt, s)); });
+    return std::clamp(n, 1, std::max(1, s.max_substeps));
+}
+
+}  // namespace drape
