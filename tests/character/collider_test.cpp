@@ -1,0 +1,200 @@
+// Bone-bound ellipsoids follow their bones; velocities and accelerations by finite
+// differences over the fixed step (method §2, §3.3); fitting and coverage.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "components/animation_player.hpp"
+#include "components/character.hpp"
+#include "components/ellipsoid_collider.hpp"
+#include "components/skeleton.hpp"
+#include "components/skinned_mesh.hpp"
+#include "components/transform.hpp"
+#include "engine/assets/character_import.hpp"
+#include "engine/core/scheduler.hpp"
+#include "systems/character/character_systems.hpp"
+#include "systems/character/pose.hpp"
+#include "systems/character/spawn.hpp"
+#include "systems/collider_system.hpp"
+#include "tests/character/test_character_file.hpp"
+
+namespace drape {
+namespace {
+
+std::shared_ptr<const CharacterAsset> column(const test::TestCharacter& spec = {}) {
+    const auto dir = test::temp_dir("collider");
+    write_test_character(spec, dir / "column.gltf");
+    auto r = import_character(dir / "column.gltf");
+    std::filesystem::remove_all(dir);
+    EXPECT_TRUE(r) << (r ? "" : r.error().message);
+    return r ? *r : nullptr;
+}
+
+Skeleton one_bone(const Affine3& global) {
+    Skeleton s;
+    s.global = {global};
+    return s;
+}
+
+TEST(EllipsoidColliders, FollowTheirBone) {
+    EllipsoidCollider c;
+    c.bone = 0;
+    c.center = Vec3(0, 0.5f, 0);
+    c.radii_m = Vec3(0.1f, 0.3f, 0.2f);
+    Affine3 bone = Affine3::Identity();
+    bone.translate(Vec3(1, 2, 3));
+    bone.rotate(Eigen::AngleAxis<Real>(Real(M_PI / 2), Vec3::UnitZ()));
+    update_collider(c, one_bone(bone), nullptr, 1.0 / 60);
+    // The centre is 0.5 m along the bone's Y, which the rotation turns to -X.
+    EXPECT_TRUE(c.world.translation().isApprox(Vec3(0.5f, 2, 3), 1e-6f)) << c.world.translation().transpose();
+    // A point on the ellipsoid's long axis ends up 0.3 m further along -X.
+    EXPECT_TRUE((c.world * Vec3(0, 1, 0)).isApprox(Vec3(0.2f, 2, 3), 1e-5f));
+}
+
+TEST(EllipsoidColliders, BoneScaleDoesNotScaleRadiiInMetres) {
+    EllipsoidCollider c;
+    c.bone = 0;
+    c.radii_m = Vec3(0.1f, 0.1f, 0.1f);
+    Affine3 bone = Affine3::Identity();
+    bone.scale(100.0f);  // an armature in centimetres
+    update_collider(c, one_bone(bone), nullptr, 1.0 / 60);
+    EXPECT_NEAR((c.world * Vec3(1, 0, 0)).norm(), 0.1f, 1e-6f);
+}
+
+TEST(EllipsoidColliders, VelocityAndAccelerationAreFiniteDifferencesOverTheStep) {
+    EllipsoidCollider c;
+    c.bone = 0;
+    const double dt = 0.01;
+    auto at = [](double t) {  // x = t^2: v = 2t, a = 2
+        Affine3 a = Affine3::Identity();
+        a.translate(Vec3(Real(t * t), 0, 0));
+        return a;
+    };
+    update_collider(c, one_bone(at(0)), nullptr, dt);
+    EXPECT_TRUE(c.initialised);
+    EXPECT_TRUE(c.velocity_m_s.isZero());
+    EXPECT_TRUE(c.acceleration_m_s2.isZero());
+    update_collider(c, one_bone(at(dt)), nullptr, dt);
+    EXPECT_NEAR(c.velocity_m_s.x(), 0.01f, 1e-5f);  // (dt^2 - 0) / dt
+    EXPECT_TRUE(c.acceleration_m_s2.isZero());      // no previous velocity yet
+    update_collider(c, one_bone(at(2 * dt)), nullptr, dt);
+    EXPECT_NEAR(c.velocity_m_s.x(), 0.03f, 1e-4f);
+    EXPECT_NEAR(c.acceleration_m_s2.x(), 2.0f, 1e-2f);
+    EXPECT_TRUE(c.previous_world.translation().isApprox(at(dt).translation()));
+}
+
+TEST(EllipsoidColliders, AngularVelocityOfASpinningBone) {
+    EllipsoidCollider c;
+    c.bone = 0;
+    const double dt = 1.0 / 60, omega = 3.0;
+    for (int i = 0; i < 3; ++i) {
+        Affine3 bone = Affine3::Identity();
+        bone.rotate(Eigen::AngleAxis<Real>(Real(omega * dt * i), Vec3::UnitY()));
+        update_collider(c, one_bone(bone), nullptr, dt);
+    }
+    EXPECT_TRUE(c.angular_velocity_rad_s.isApprox(Vec3(0, Real(omega), 0), 1e-3f)) << c.angular_velocity_rad_s.transpose();
+}
+
+TEST(EllipsoidFitting, CoversTheTestColumnAndTagsNothingAsPelvis) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    ASSERT_FALSE(c->ellipsoids.empty());
+    std::vector<Affine3> global, skinning;
+    compose_pose(*c->skeleton, c->skeleton->rest_local, global);
+    skinning_matrices(*c->skeleton, global, skinning);
+    Matrix3X p, n;
+    skin_mesh(*c->mesh, skinning, Affine3::Identity(), p, n);
+    const CoverageReport r = measure_coverage(c->ellipsoids, global, p, n);
+    EXPECT_GE(r.coverage, 0.95);
+    EXPECT_EQ(find_hip_bone(*c->skeleton), -1);  // "Root" and "Child" are no hips
+    for (const EllipsoidShape& s : c->ellipsoids) {
+        EXPECT_TRUE(s.radii_m.allFinite());
+        EXPECT_GT(s.radii_m.minCoeff(), 0);
+    }
+}
+
+TEST(EllipsoidFitting, HipBoneIsFoundByNameOrByTheLegs) {
+    SkeletonAsset s;
+    s.bone_names = {"Armature", "mixamorig:Hips", "LeftUpLeg", "RightUpLeg"};
+    s.parents = {-1, 0, 1, 1};
+    EXPECT_EQ(find_hip_bone(s), 1);
+    s.bone_names = {"Armature", "root_joint", "thigh.L", "thigh.R"};
+    EXPECT_EQ(find_hip_bone(s), 1);
+    EXPECT_EQ(region_from_bone_name("LeftForeArm"), BodyRegion::lower_arm);
+    EXPECT_EQ(region_from_bone_name("LeftLeg"), BodyRegion::lower_leg);
+    EXPECT_EQ(region_from_bone_name("UpperLeg.R"), BodyRegion::upper_leg);
+}
+
+TEST(EllipsoidFitting, OverridesFromJsonReplaceTheFittedShapeOfTheirBone) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    auto o = ellipsoids_from_json(R"([{"bone": "Child", "center": [0, 0.5, 0], "radii_m": [0.3, 0.6, 0.3], "region": "torso"}])",
+                                  *c->skeleton, "scene.json");
+    ASSERT_TRUE(o) << o.error().message;
+    ASSERT_EQ(o->size(), 1u);
+    EXPECT_EQ((*o)[0].region, BodyRegion::torso);
+    const auto merged = apply_overrides(c->ellipsoids, *o);
+    const int child = c->skeleton->find("Child");
+    EXPECT_EQ(std::count_if(merged.begin(), merged.end(), [&](auto& s) { return s.bone == child; }), 1);
+    EXPECT_TRUE(std::any_of(merged.begin(), merged.end(), [&](auto& s) { return s.radii_m.y() == 0.6f; }));
+
+    auto bad = ellipsoids_from_json(R"([{"bone": "Tail", "center": [0,0,0], "radii_m": [1,1,1]}])", *c->skeleton, "scene.json");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().message, "scene.json: colliders[0].bone: no bone named 'Tail'");
+    bad = ellipsoids_from_json(R"([{"bone": "Child", "center": [0,0,0], "radii_m": [1,0,1]}])", *c->skeleton, "scene.json");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().message, "scene.json: colliders[0].radii_m: must be > 0");
+}
+
+TEST(CharacterSystems, SpawnedCharacterAnimatesSkinsAndMovesItsColliders) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    Registry registry;
+    SpawnOptions options;
+    options.transform.position = Vec3(3, 0, 0);
+    auto e = spawn_character(registry, c, options);
+    ASSERT_TRUE(e) << e.error().message;
+    const auto colliders = colliders_of(registry, *e);
+    ASSERT_EQ(colliders.size(), c->ellipsoids.size());
+    // Valid at once: the skinned mesh is the rest mesh moved to x = 3.
+    const SkinnedMesh& skin = registry.get<SkinnedMesh>(*e);
+    EXPECT_NEAR(skin.positions.row(0).mean(), 3.0f, 1e-4f);
+
+    Scheduler scheduler;
+    add_character_systems(scheduler);
+    EXPECT_EQ(scheduler.system_names(Phase::skinning), (std::vector<std::string>{"skinning", "colliders"}));
+    const int child = c->skeleton->find("Child");
+    const auto top = std::find_if(colliders.begin(), colliders.end(),
+                                  [&](Entity x) { return registry.get<EllipsoidCollider>(x).bone == child; });
+    ASSERT_NE(top, colliders.end());
+    const Vec3 before = registry.get<EllipsoidCollider>(*top).world.translation();
+    for (int i = 0; i < 30; ++i) ASSERT_TRUE(scheduler.tick(registry, 1.0 / 60));  // half the bend
+    const EllipsoidCollider& moved = registry.get<EllipsoidCollider>(*top);
+    EXPECT_TRUE(moved.initialised);
+    EXPECT_GT((moved.world.translation() - before).norm(), 0.05f);
+    EXPECT_GT(moved.velocity_m_s.norm(), 0.0f);
+    // The collider sits where its bone's pose says (in place: root travel removed).
+    const Skeleton& skeleton = registry.get<Skeleton>(*e);
+    const EllipsoidShape& shape = *std::find_if(c->ellipsoids.begin(), c->ellipsoids.end(), [&](auto& s) { return s.bone == child; });
+    const Affine3 expected = registry.get<Transform>(*e).matrix() * ellipsoid_transform(shape, skeleton.global[std::size_t(child)]);
+    EXPECT_TRUE(moved.world.isApprox(expected, 1e-5f));
+    EXPECT_NEAR(skeleton.global[0].translation().z(), 0.0f, 1e-5f);
+
+    despawn_character(registry, *e);
+    EXPECT_EQ(registry.alive(), 0u);
+}
+
+TEST(CharacterSystems, SpawnRejectsAClipThatIsNotThere) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    Registry registry;
+    SpawnOptions options;
+    options.clip = "Run";
+    auto e = spawn_character(registry, c, options);
+    ASSERT_FALSE(e);
+    EXPECT_NE(e.error().message.find("no clip named 'Run'"), std::string::npos);
+    EXPECT_EQ(registry.alive(), 0u);
+}
+
+}  // namespace
+}  // namespace drape

@@ -1,0 +1,113 @@
+// Every third-party character in ../shared/assets/characters imports with its clips,
+// bones and normalised weights, and gets fitted ellipsoids that cover it. These files
+// live outside the project; without them the tests skip and say so.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "engine/assets/character_import.hpp"
+#include "systems/character/pose.hpp"
+
+namespace drape {
+namespace {
+
+std::filesystem::path shared(const char* relative) { return std::filesystem::path(DRAPE_SHARED_ASSETS) / relative; }
+
+#define REQUIRE_SHARED(path)                                                                          \
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared test characters absent: " << (path)
+
+struct Expect {
+    const char* file;
+    std::size_t clips;
+    const char* walk;
+    double walk_s;
+    int min_skin_bones;
+    bool human;
+};
+
+class SharedCharacter : public ::testing::TestWithParam<Expect> {};
+
+TEST_P(SharedCharacter, ImportsWithClipsBonesNormalisedWeightsAndCoveringEllipsoids) {
+    const Expect& e = GetParam();
+    const auto path = shared(e.file);
+    REQUIRE_SHARED(path);
+    auto r = import_character(path);
+    ASSERT_TRUE(r) << r.error().message;
+    const CharacterAsset& c = **r;
+    EXPECT_EQ(c.clips.size(), e.clips);
+    auto walk = find_clip(c, e.walk);
+    ASSERT_TRUE(walk) << walk.error().message;
+    EXPECT_NEAR(c.clips[*walk]->duration_s, e.walk_s, 0.01);
+    EXPECT_GE(c.skin_bones, e.min_skin_bones);
+    const MeshAsset& m = *c.mesh;
+    for (Eigen::Index j = 0; j < m.bone_weights.cols(); ++j) ASSERT_NEAR(m.bone_weights.col(j).sum(), 1.0f, 1e-5f) << j;
+    ASSERT_TRUE(m.bind_positions.allFinite());
+
+    EXPECT_GE(c.height_m, e.human ? 1.5f : 0.1f);
+    EXPECT_LE(c.height_m, e.human ? 2.0f : 3.0f);
+    ASSERT_FALSE(c.ellipsoids.empty());
+    std::vector<Affine3> global, skinning;
+    compose_pose(*c.skeleton, c.skeleton->rest_local, global);
+    skinning_matrices(*c.skeleton, global, skinning);
+    Matrix3X p, n;
+    skin_mesh(m, skinning, Affine3::Identity(), p, n);
+    const CoverageReport report = measure_coverage(c.ellipsoids, global, p, n);
+    EXPECT_GE(report.coverage, 0.95) << e.file;
+    if (e.human) {
+        EXPECT_GE(c.ellipsoids.size(), 10u);
+        EXPECT_LE(c.ellipsoids.size(), 20u);
+        EXPECT_GE(c.hip_bone, 0);
+        EXPECT_TRUE(std::any_of(c.ellipsoids.begin(), c.ellipsoids.end(), [](auto& s) { return s.region == BodyRegion::pelvis; }));
+        // Standing on the ground, Y up: feet near the bottom, head at the top.
+        EXPECT_NEAR(p.row(1).minCoeff(), 0.0f, 0.05f);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Characters, SharedCharacter,
+    ::testing::Values(Expect{"characters/male_casual/Male_Casual.fbx", 11, "HumanArmature|Man_Walk", 1.04, 25, true},
+                      Expect{"characters/robot_expressive/RobotExpressive.glb", 14, "Walking", 0.96, 20, true},
+                      Expect{"characters/rigged_simple/RiggedSimple.glb", 1, "0", 2.08, 2, false}),
+    [](const auto& info) { return std::filesystem::path(info.param.file).stem().string(); });
+
+TEST(SharedCharacterFbx, BindPoseIsAWideTPoseWhileTheRestPoseHasArmsDown) {
+    const auto path = shared("characters/male_casual/Male_Casual.fbx");
+    REQUIRE_SHARED(path);
+    auto r = import_character(path);
+    ASSERT_TRUE(r) << r.error().message;
+    const CharacterAsset& c = **r;
+    std::vector<Affine3> global, skinning;
+    compose_pose(*c.skeleton, c.skeleton->rest_local, global);
+    skinning_matrices(*c.skeleton, global, skinning);
+    Matrix3X rest;
+    skin_positions(*c.mesh, skinning, Affine3::Identity(), rest);
+    const Real bind_width = c.mesh->bind_positions.row(0).maxCoeff() - c.mesh->bind_positions.row(0).minCoeff();
+    const Real rest_width = rest.row(0).maxCoeff() - rest.row(0).minCoeff();
+    EXPECT_GT(bind_width, 1.5f * rest_width) << bind_width << " vs " << rest_width;
+}
+
+TEST(SharedCharacterGltf, RigidlyParentedMeshesBecomeSkinnedToTheirBone) {
+    const auto path = shared("characters/robot_expressive/RobotExpressive.glb");
+    REQUIRE_SHARED(path);
+    auto r = import_character(path);
+    ASSERT_TRUE(r) << r.error().message;
+    const CharacterAsset& c = **r;
+    EXPECT_EQ(c.meshes.size(), 19u);
+    EXPECT_EQ(std::count_if(c.meshes.begin(), c.meshes.end(), [](auto& m) { return m.rigid; }), 15);
+    // A rigid foot follows its bone: playing the walk moves its vertices.
+    auto walk = find_clip(c, "Walking");
+    ASSERT_TRUE(walk);
+    std::vector<Affine3> local, global, skinning;
+    Matrix3X a, b;
+    for (double t : {0.0, 0.4}) {
+        sample_clip(*c.clips[*walk], *c.skeleton, t, true, local);
+        compose_pose(*c.skeleton, local, global);
+        skinning_matrices(*c.skeleton, global, skinning);
+        skin_positions(*c.mesh, skinning, Affine3::Identity(), t == 0 ? a : b);
+    }
+    EXPECT_GT((a - b).colwise().norm().maxCoeff(), 0.05f);
+    EXPECT_TRUE(b.allFinite());
+}
+
+}  // namespace
+}  // namespace drape
