@@ -52,7 +52,7 @@ Result<std::shared_ptr<const AnimationClip>> import_bvh_motion(const std::filesy
         const aiNode* node = scene->mRootNode->FindNode(ch->mNodeName);
         if (node == nullptr) continue;
         const aiNode* parent = node->mParent;
-        const bool is_root = parent == nullptr || parent == scene->mRootNode || skeleton.find(parent->mName.C_Str()) < 0;
+        const bool is_root = parent == nullptr || skeleton.find(parent->mName.C_Str()) < 0;
         if (is_root) {
             if (bvh_root != nullptr) return fail(at + ": more than one root joint ('" + std::string(bvh_root->mName.C_Str()) + "', '" + ch->mNodeName.C_Str() + "')");
             bvh_root = node;
