@@ -1,0 +1,630 @@
+// The renderer: context, frame buffers and the scene pass.
+//
+// Frame: bind the (multisampled) draw framebuffer, clear; ground with blob contact
+// shadows; planar shadows of bodies and garments along the key light (stencil: each pixel
+// darkened once); bodies; garments (two-sided); translucent ellipsoids; resolve into a
+// single-sample framebuffer that read_pixels() reads and present() blits to the window.
+//
+// GPU buffers are kept per entity and updated with glNamedBufferSubData each frame; they
+// are created when an entity first appears (or its mesh changes) and freed when it is gone,
+// so a steady scene allocates nothing per frame.
+#include "engine/render/renderer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numbers>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "components/skinned_mesh.hpp"
+#include "engine/render/egl_context.hpp"
+#include "engine/render/gl.hpp"
+#include "engine/render/shaders.hpp"
+#include "engine/render/x11_window.hpp"
+
+namespace drape {
+
+using render_detail::EglContext;
+using render_detail::X11Window;
+
+Result<void> validate(const RenderSettings& s) {
+    if (s.width < 16 || s.width > 8192) return fail("render settings: width: " + std::to_string(s.width) + " is outside 16..8192 px");
+    if (s.height < 16 || s.height > 8192) return fail("render settings: height: " + std::to_string(s.height) + " is outside 16..8192 px");
+    if (s.msaa_samples < 0 || s.msaa_samples > 16) return fail("render settings: msaa_samples: " + std::to_string(s.msaa_samples) + " is outside 0..16");
+    if (!s.clear_color.allFinite() || (s.clear_color.array() < 0).any() || (s.clear_color.array() > 1).any())
+        return fail("render settings: clear_color: each channel must be in 0..1");
+    return {};
+}
+
+namespace {
+
+constexpr int max_blobs = 8;
+
+std::uint64_t key_of(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
+
+Mat3 normal_matrix(const Affine3& m) { return m.linear().inverse().transpose(); }
+
+/// Flattens points onto y = lift along the (towards-the-light) direction l.
+Mat4 planar_shadow_matrix(const Vec3& l, Real lift) {
+    Mat4 m = Mat4::Identity();
+    m(0, 1) = -l.x() / l.y();
+    m(0, 3) = l.x() / l.y() * lift;
+    m(1, 1) = 0;
+    m(1, 3) = lift;
+    m(2, 1) = -l.z() / l.y();
+    m(2, 3) = l.z() / l.y() * lift;
+    return m;
+}
+
+/// Vertex array with positions (location 0) and normals (location 1), each a tightly
+/// packed float3 buffer, and an index buffer. Buffer sizes are fixed at creation.
+struct MeshBuffers {
+    GLuint vao = 0, positions = 0, normals = 0, indices = 0;
+    GLsizei vertex_count = 0, index_count = 0;
+
+    void create(GLsizei vertices, const std::uint32_t* index_data, GLsizei indices_count) {
+        vertex_count = vertices;
+        index_count = indices_count;
+        const GLsizeiptr bytes = GLsizeiptr(vertices) * 3 * GLsizeiptr(sizeof(float));
+        glCreateBuffers(1, &positions);
+        glNamedBufferData(positions, bytes, nullptr, GL_DYNAMIC_DRAW);
+        glCreateBuffers(1, &normals);
+        glNamedBufferData(normals, bytes, nullptr, GL_DYNAMIC_DRAW);
+        glCreateBuffers(1, &indices);
+        glNamedBufferData(indices, GLsizeiptr(indices_count) * GLsizeiptr(sizeof(std::uint32_t)), index_data, GL_STATIC_DRAW);
+        glCreateVertexArrays(1, &vao);
+        glVertexArrayVertexBuffer(vao, 0, positions, 0, 3 * sizeof(float));
+        glVertexArrayVertexBuffer(vao, 1, normals, 0, 3 * sizeof(float));
+        for (GLuint i = 0; i < 2; ++i) {
+            glEnableVertexArrayAttrib(vao, i);
+            glVertexArrayAttribFormat(vao, i, 3, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, i, i);
+        }
+        glVertexArrayElementBuffer(vao, indices);
+    }
+    void upload(const Matrix3X& p, const Matrix3X& n) const {
+        const GLsizeiptr bytes = GLsizeiptr(vertex_count) * 3 * GLsizeiptr(sizeof(float));
+        glNamedBufferSubData(positions, 0, bytes, p.data());
+        glNamedBufferSubData(normals, 0, bytes, n.data());
+    }
+    void destroy() {
+        if (vao != 0) glDeleteVertexArrays(1, &vao);
+        const GLuint buffers[3] = {positions, normals, indices};
+        glDeleteBuffers(3, buffers);
+        *this = {};
+    }
+};
+
+/// Area-weighted vertex normals of a triangle list (counter-clockwise = front).
+void compute_normals(const Matrix3X& x, const std::vector<std::uint32_t>& triangles, Matrix3X& normals) {
+    normals.setZero(3, x.cols());
+    for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
+        const auto a = triangles[t], b = triangles[t + 1], c = triangles[t + 2];
+        const Vec3 face = (x.col(b) - x.col(a)).cross(x.col(c) - x.col(a));
+        normals.col(a) += face;
+        normals.col(b) += face;
+        normals.col(c) += face;
+    }
+    for (Eigen::Index i = 0; i < normals.cols(); ++i) {
+        const Real length = normals.col(i).norm();
+        if (length > Real(1e-20) && std::isfinite(length)) normals.col(i) /= length;
+        else normals.col(i) = Vec3::UnitY();
+    }
+}
+
+/// First index that is out of range, or -1.
+long long first_bad_index(const std::vector<std::uint32_t>& indices, std::size_t vertex_count) {
+    for (std::size_t i = 0; i < indices.size(); ++i)
+        if (indices[i] >= vertex_count) return static_cast<long long>(i);
+    return -1;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+    RenderSettings settings;
+    RendererInfo info;
+    Camera camera;
+    bool show_ellipsoids = false;
+
+    std::unique_ptr<X11Window> window;     // destroyed after the context (declared first)
+    std::unique_ptr<EglContext> context;
+
+    GLuint draw_fbo = 0, draw_color = 0, draw_depth = 0;
+    GLuint resolve_fbo = 0, resolve_color = 0;
+    GLuint empty_vao = 0;
+    GLuint lit = 0, ground = 0, shadow = 0;
+    struct {
+        GLint view_projection, model, normal_matrix, color, eye, two_sided, specular, shininess, rim;
+    } lit_u{};
+    struct {
+        GLint view_projection, center, half_size, eye, sky, albedo, blob_count, blobs;
+    } ground_u{};
+    struct {
+        GLint view_projection, shadow, darkness;
+    } shadow_u{};
+    MeshBuffers sphere;
+
+    struct BodyEntry {
+        MeshBuffers buffers;
+        const MeshAsset* mesh = nullptr;
+        Matrix3X computed_normals;  // when the skin carries no normals
+        std::uint64_t seen = 0;
+    };
+    struct GarmentEntry {
+        MeshBuffers buffers;
+        const GarmentTopology* topology = nullptr;
+        Matrix3X normals;
+        Vec3 color = Vec3::Zero();
+        std::uint64_t seen = 0;
+    };
+    std::unordered_map<std::uint64_t, BodyEntry> bodies;
+    std::unordered_map<std::uint64_t, GarmentEntry> garments;
+    std::vector<std::uint64_t> stale;   // scratch
+    std::vector<std::uint8_t> readback; // scratch, bottom row first
+    std::uint64_t frame = 0;
+    std::string frame_error;            // first problem of the last draw
+    bool drawn = false;
+
+    ~Impl() {
+        if (!context || !context->make_current()) return;
+        for (auto& [key, body] : bodies) body.buffers.destroy();
+        for (auto& [key, garment] : garments) garment.buffers.destroy();
+        sphere.destroy();
+        glDeleteProgram(lit);
+        glDeleteProgram(ground);
+        glDeleteProgram(shadow);
+        glDeleteVertexArrays(1, &empty_vao);
+        const GLuint fbos[2] = {draw_fbo, resolve_fbo};
+        glDeleteFramebuffers(2, fbos);
+        const GLuint rbs[3] = {draw_color, draw_depth, resolve_color};
+        glDeleteRenderbuffers(3, rbs);
+    }
+
+    void note(std::string message) {
+        if (frame_error.empty()) frame_error = std::move(message);
+    }
+
+    Result<void> create_framebuffers();
+    Result<void> create_programs();
+    void create_sphere();
+    void draw(Registry& registry);
+    GLuint read_fbo() const { return resolve_fbo != 0 ? resolve_fbo : draw_fbo; }
+};
+
+Result<void> Renderer::Impl::create_framebuffers() {
+    GLint max_samples = 0;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    int samples = settings.msaa_samples <= 1 ? 0 : std::min(settings.msaa_samples, max_samples);
+    if (samples <= 1) samples = 0;
+    info.msaa_samples = samples;
+    const GLsizei w = settings.width, h = settings.height;
+
+    glCreateRenderbuffers(1, &draw_color);
+    glCreateRenderbuffers(1, &draw_depth);
+    glNamedRenderbufferStorageMultisample(draw_color, samples, GL_RGBA8, w, h);
+    glNamedRenderbufferStorageMultisample(draw_depth, samples, GL_DEPTH24_STENCIL8, w, h);
+    glCreateFramebuffers(1, &draw_fbo);
+    glNamedFramebufferRenderbuffer(draw_fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, draw_color);
+    glNamedFramebufferRenderbuffer(draw_fbo, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, draw_depth);
+    if (glCheckNamedFramebufferStatus(draw_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return fail("OpenGL: the " + std::to_string(w) + "x" + std::to_string(h) + " draw framebuffer (" +
+                    std::to_string(samples) + " samples) is incomplete");
+    if (samples > 0) {
+        glCreateRenderbuffers(1, &resolve_color);
+        glNamedRenderbufferStorage(resolve_color, GL_RGBA8, w, h);
+        glCreateFramebuffers(1, &resolve_fbo);
+        glNamedFramebufferRenderbuffer(resolve_fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_color);
+        if (glCheckNamedFramebufferStatus(resolve_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            return fail("OpenGL: the resolve framebuffer is incomplete");
+    }
+    if (const GLenum error = glGetError(); error != GL_NO_ERROR)
+        return fail("OpenGL: cannot allocate " + std::to_string(w) + "x" + std::to_string(h) +
+                    " frame buffers (GL error 0x" + std::to_string(error) + ")");
+    return {};
+}
+
+Result<void> Renderer::Impl::create_programs() {
+    auto l = render_detail::build_program("lit", render_detail::lit_vertex_shader, render_detail::lit_fragment_shader);
+    if (!l) return fail(l.error().message);
+    lit = *l;
+    auto g = render_detail::build_program("ground", render_detail::ground_vertex_shader,
+                                          render_detail::ground_fragment_shader);
+    if (!g) return fail(g.error().message);
+    ground = *g;
+    auto s = render_detail::build_program("shadow", render_detail::shadow_vertex_shader,
+                                          render_detail::shadow_fragment_shader);
+    if (!s) return fail(s.error().message);
+    shadow = *s;
+    auto at = [](GLuint p, const char* n) { return glGetUniformLocation(p, n); };
+    lit_u = {at(lit, "u_view_projection"), at(lit, "u_model"), at(lit, "u_normal_matrix"), at(lit, "u_color"),
+             at(lit, "u_eye"), at(lit, "u_two_sided"), at(lit, "u_specular"), at(lit, "u_shininess"), at(lit, "u_rim")};
+    ground_u = {at(ground, "u_view_projection"), at(ground, "u_center"), at(ground, "u_half_size"),
+                at(ground, "u_eye"), at(ground, "u_sky"), at(ground, "u_albedo"), at(ground, "u_blob_count"),
+                at(ground, "u_blobs")};
+    shadow_u = {at(shadow, "u_view_projection"), at(shadow, "u_shadow"), at(shadow, "u_darkness")};
+    glCreateVertexArrays(1, &empty_vao);
+    return {};
+}
+
+void Renderer::Impl::create_sphere() {
+    constexpr int slices = 32, stacks = 16;
+    Matrix3X p(3, (slices + 1) * (stacks + 1));
+    std::vector<std::uint32_t> indices;
+    indices.reserve(slices * stacks * 6);
+    for (int i = 0; i <= stacks; ++i) {
+        const Real theta = Real(std::numbers::pi) * Real(i) / stacks;
+        for (int j = 0; j <= slices; ++j) {
+            const Real phi = 2 * Real(std::numbers::pi) * Real(j) / slices;
+            p.col(i * (slices + 1) + j) = Vec3(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
+        }
+    }
+    for (int i = 0; i < stacks; ++i)
+        for (int j = 0; j < slices; ++j) {
+            const std::uint32_t a = std::uint32_t(i * (slices + 1) + j), b = a + slices + 1;
+            indices.insert(indices.end(), {a, b, a + 1, a + 1, b, b + 1});
+        }
+    sphere.create(GLsizei(p.cols()), indices.data(), GLsizei(indices.size()));
+    sphere.upload(p, p);  // unit sphere: normal = position
+}
+
+void Renderer::Impl::draw(Registry& registry) {
+    ++frame;
+    frame_error.clear();
+    const GLsizei w = settings.width, h = settings.height;
+    const Mat4 view_projection = camera.projection(Real(w) / Real(h)) * camera.view();
+    const Vec3 eye = camera.eye();
+    const Vec3 key_direction = Vec3(-0.45f, 0.80f, 0.55f).normalized();  // as in the shaders
+
+    // --- Gather and upload: bodies -------------------------------------------------------
+    std::array<Eigen::Vector4f, max_blobs> blobs;
+    int blob_count = 0;
+    registry.view<SkinnedMesh>().each([&](Entity e, SkinnedMesh& skin) {
+        if (!skin.mesh || skin.positions.cols() == 0) return;
+        const MeshAsset& mesh = *skin.mesh;
+        BodyEntry& entry = bodies[key_of(e)];
+        entry.seen = frame;
+        if (entry.mesh != &mesh || entry.buffers.vertex_count != skin.positions.cols()) {
+            entry.buffers.destroy();
+            entry.mesh = nullptr;
+            if (skin.positions.cols() != Eigen::Index(mesh.vertex_count())) {
+                note("skinned mesh of entity " + std::to_string(e.index) + ": " + std::to_string(skin.positions.cols()) +
+                     " skinned positions for a mesh of " + std::to_string(mesh.vertex_count()) + " vertices");
+                return;
+            }
+            if (mesh.indices.size() % 3 != 0) {
+                note("skinned mesh of entity " + std::to_string(e.index) + ": index count " +
+                     std::to_string(mesh.indices.size()) + " is not a multiple of 3");
+                return;
+            }
+            if (auto bad = first_bad_index(mesh.indices, mesh.vertex_count()); bad >= 0) {
+                note("skinned mesh of entity " + std::to_string(e.index) + ": indices[" + std::to_string(bad) +
+                     "] = " + std::to_string(mesh.indices[std::size_t(bad)]) + " is past its " +
+                     std::to_string(mesh.vertex_count()) + " vertices");
+                return;
+            }
+            for (const Submesh& s : mesh.submeshes)
+                if (std::uint64_t(s.first_index) + s.index_count > mesh.indices.size()) {
+                    note("skinned mesh of entity " + std::to_string(e.index) + ": submesh \"" + s.name +
+                         "\" reaches past the index list");
+                    return;
+                }
+            entry.buffers.create(GLsizei(skin.positions.cols()), mesh.indices.data(), GLsizei(mesh.indices.size()));
+            entry.mesh = &mesh;
+        }
+        if (skin.normals.cols() == skin.positions.cols()) {
+            entry.buffers.upload(skin.positions, skin.normals);
+        } else {
+            compute_normals(skin.positions, mesh.indices, entry.computed_normals);
+            entry.buffers.upload(skin.positions, entry.computed_normals);
+        }
+        // Contact shadow: a soft blob under the footprint of the body's lowest quarter (the
+        // feet and legs, not the swinging arms), fading as the body leaves the ground.
+        if (blob_count < max_blobs) {
+            const Vec3 lo = skin.positions.rowwise().minCoeff(), hi = skin.positions.rowwise().maxCoeff();
+            if (lo.allFinite() && hi.allFinite()) {
+                const Real feet_top = lo.y() + Real(0.25) * (hi.y() - lo.y());
+                Eigen::Vector2f feet_lo(hi.x(), hi.z()), feet_hi(lo.x(), lo.z());
+                for (Eigen::Index i = 0; i < skin.positions.cols(); ++i)
+                    if (skin.positions(1, i) <= feet_top) {
+                        const Eigen::Vector2f q(skin.positions(0, i), skin.positions(2, i));
+                        feet_lo = feet_lo.cwiseMin(q);
+                        feet_hi = feet_hi.cwiseMax(q);
+                    }
+                const Eigen::Vector2f extent = feet_hi - feet_lo;
+                const Real radius = std::clamp(Real(0.9) * extent.maxCoeff(), Real(0.2), Real(1.0));
+                const Real lift = std::clamp(lo.y() / Real(0.5), Real(0), Real(1));
+                const Eigen::Vector2f centre = Real(0.5) * (feet_lo + feet_hi);
+                blobs[std::size_t(blob_count++)] = Eigen::Vector4f(centre.x(), centre.y(), radius, Real(0.8) * (1 - lift));
+            }
+        }
+    });
+
+    // --- Gather and upload: garments -----------------------------------------------------
+    registry.view<Garment>().each([&](Entity e, Garment& garment) {
+        if (!garment.topology || garment.x.cols() == 0 || garment.topology->triangles.empty()) return;
+        const GarmentTopology& topology = *garment.topology;
+        GarmentEntry& entry = garments[key_of(e)];
+        entry.seen = frame;
+        if (entry.topology != &topology || entry.buffers.vertex_count != garment.x.cols()) {
+            entry.buffers.destroy();
+            entry.topology = nullptr;
+            if (topology.triangles.size() % 3 != 0) {
+                note("garment of entity " + std::to_string(e.index) + ": triangle index count " +
+                     std::to_string(topology.triangles.size()) + " is not a multiple of 3");
+                return;
+            }
+            if (auto bad = first_bad_index(topology.triangles, std::size_t(garment.x.cols())); bad >= 0) {
+                note("garment of entity " + std::to_string(e.index) + ": triangles[" + std::to_string(bad) + "] = " +
+                     std::to_string(topology.triangles[std::size_t(bad)]) + " is past its " +
+                     std::to_string(garment.x.cols()) + " particles");
+                return;
+            }
+            entry.buffers.create(GLsizei(garment.x.cols()), topology.triangles.data(), GLsizei(topology.triangles.size()));
+            entry.topology = &topology;
+        }
+        compute_normals(garment.x, topology.triangles, entry.normals);
+        entry.buffers.upload(garment.x, entry.normals);
+        entry.color = garment.color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones());
+    });
+
+    // Free the buffers of entities that are gone.
+    auto sweep = [&](auto& map) {
+        stale.clear();
+        for (auto& [key, entry] : map)
+            if (entry.seen != frame) stale.push_back(key);
+        for (std::uint64_t key : stale) {
+            map[key].buffers.destroy();
+            map.erase(key);
+        }
+    };
+    sweep(bodies);
+    sweep(garments);
+
+    // --- Clear ---------------------------------------------------------------------------
+    glBindFramebuffer(GL_FRAMEBUFFER, draw_fbo);
+    glViewport(0, 0, w, h);
+    const Vec3 clear = settings.clear_color.array().pow(Real(1 / 2.2));
+    glClearColor(clear.x(), clear.y(), clear.z(), 1);
+    glClearStencil(0);
+    glDepthMask(GL_TRUE);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    if (info.msaa_samples > 0) glEnable(GL_MULTISAMPLE);
+
+    // --- Ground ---------------------------------------------------------------------------
+    glUseProgram(ground);
+    glUniformMatrix4fv(ground_u.view_projection, 1, GL_FALSE, view_projection.data());
+    glUniform2f(ground_u.center, std::round(camera.target.x()), std::round(camera.target.z()));
+    glUniform1f(ground_u.half_size, 80.0f);
+    glUniform3fv(ground_u.eye, 1, eye.data());
+    glUniform3fv(ground_u.sky, 1, settings.clear_color.data());
+    glUniform3f(ground_u.albedo, 0.38f, 0.37f, 0.35f);
+    glUniform1i(ground_u.blob_count, blob_count);
+    if (blob_count > 0) glUniform4fv(ground_u.blobs, blob_count, blobs[0].data());
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+
+    // --- Planar shadows: every caster flattened onto the ground, each pixel darkened once.
+    glUseProgram(shadow);
+    glUniformMatrix4fv(shadow_u.view_projection, 1, GL_FALSE, view_projection.data());
+    const Mat4 flatten = planar_shadow_matrix(key_direction, Real(0.002));
+    glUniformMatrix4fv(shadow_u.shadow, 1, GL_FALSE, flatten.data());
+    glUniform1f(shadow_u.darkness, 0.38f);
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_EQUAL, 0, 0xFF);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    for (auto& [key, body] : bodies)
+        if (body.mesh != nullptr) {
+            glBindVertexArray(body.buffers.vao);
+            glDrawElements(GL_TRIANGLES, body.buffers.index_count, GL_UNSIGNED_INT, nullptr);
+        }
+    for (auto& [key, garment] : garments)
+        if (garment.topology != nullptr) {
+            glBindVertexArray(garment.buffers.vao);
+            glDrawElements(GL_TRIANGLES, garment.buffers.index_count, GL_UNSIGNED_INT, nullptr);
+        }
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+
+    // --- Bodies and garments ------------------------------------------------------------
+    glUseProgram(lit);
+    glUniformMatrix4fv(lit_u.view_projection, 1, GL_FALSE, view_projection.data());
+    const Mat4 identity = Mat4::Identity();
+    const Mat3 identity3 = Mat3::Identity();
+    glUniformMatrix4fv(lit_u.model, 1, GL_FALSE, identity.data());
+    glUniformMatrix3fv(lit_u.normal_matrix, 1, GL_FALSE, identity3.data());
+    glUniform3fv(lit_u.eye, 1, eye.data());
+    glUniform1i(lit_u.two_sided, 0);
+    glUniform1f(lit_u.specular, 0.18f);
+    glUniform1f(lit_u.shininess, 24.0f);
+    glUniform1f(lit_u.rim, 0.25f);
+    for (auto& [key, body] : bodies) {
+        if (body.mesh == nullptr) continue;
+        glBindVertexArray(body.buffers.vao);
+        if (body.mesh->submeshes.empty()) {
+            glUniform4f(lit_u.color, 0.8f, 0.7f, 0.6f, 1.0f);
+            glDrawElements(GL_TRIANGLES, body.buffers.index_count, GL_UNSIGNED_INT, nullptr);
+            continue;
+        }
+        for (const Submesh& s : body.mesh->submeshes) {
+            const Vec3 c = s.color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones());
+            glUniform4f(lit_u.color, c.x(), c.y(), c.z(), 1.0f);
+            glDrawElements(GL_TRIANGLES, GLsizei(s.index_count), GL_UNSIGNED_INT,
+                           reinterpret_cast<const void*>(std::uintptr_t(s.first_index) * sizeof(std::uint32_t)));
+        }
+    }
+    glUniform1i(lit_u.two_sided, 1);
+    glUniform1f(lit_u.specular, 0.06f);
+    glUniform1f(lit_u.shininess, 12.0f);
+    glUniform1f(lit_u.rim, 0.15f);
+    for (auto& [key, garment] : garments) {
+        if (garment.topology == nullptr) continue;
+        glUniform4f(lit_u.color, garment.color.x(), garment.color.y(), garment.color.z(), 1.0f);
+        glBindVertexArray(garment.buffers.vao);
+        glDrawElements(GL_TRIANGLES, garment.buffers.index_count, GL_UNSIGNED_INT, nullptr);
+    }
+
+    // --- Translucent ellipsoids (front faces only, no depth writes) ----------------------
+    if (show_ellipsoids) {
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+        glDepthMask(GL_FALSE);
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+        glUniform1i(lit_u.two_sided, 0);
+        glUniform1f(lit_u.specular, 0.3f);
+        glUniform4f(lit_u.color, 0.15f, 0.75f, 0.95f, 0.32f);
+        glBindVertexArray(sphere.vao);
+        registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+            if (!c.world.matrix().allFinite() || std::abs(c.world.linear().determinant()) < Real(1e-12)) return;
+            const Mat4 model = c.world.matrix();
+            const Mat3 normals = normal_matrix(c.world);
+            glUniformMatrix4fv(lit_u.model, 1, GL_FALSE, model.data());
+            glUniformMatrix3fv(lit_u.normal_matrix, 1, GL_FALSE, normals.data());
+            glDrawElements(GL_TRIANGLES, sphere.index_count, GL_UNSIGNED_INT, nullptr);
+        });
+        glDisable(GL_CULL_FACE);
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
+    }
+    glBindVertexArray(0);
+
+    // --- Resolve -------------------------------------------------------------------------
+    if (resolve_fbo != 0)
+        glBlitNamedFramebuffer(draw_fbo, resolve_fbo, 0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (const GLenum error = glGetError(); error != GL_NO_ERROR)
+        note("OpenGL error 0x" + [error] {
+            char buffer[16];
+            std::snprintf(buffer, sizeof buffer, "%04x", unsigned(error));
+            return std::string(buffer);
+        }() + " while drawing the frame");
+    drawn = true;
+}
+
+// ---------------------------------------------------------------------------------------
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+Renderer::~Renderer() = default;
+
+Result<std::unique_ptr<Renderer>> Renderer::create(const RenderSettings& settings) {
+    if (auto ok = validate(settings); !ok) return fail(ok.error().message);
+    auto impl = std::make_unique<Impl>();
+    impl->settings = settings;
+    if (settings.target == RenderTarget::window) {
+        auto window = X11Window::create(settings.width, settings.height, settings.window_title);
+        if (!window) return fail(window.error().message);
+        impl->window = std::move(*window);
+        auto context = EglContext::create_window(impl->window->display(), impl->window->window(), settings.vsync);
+        if (!context) return fail(context.error().message);
+        impl->context = std::move(*context);
+    } else {
+        auto context = EglContext::create_offscreen();
+        if (!context) return fail(context.error().message);
+        impl->context = std::move(*context);
+    }
+    GLint major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    auto text = [](GLenum name) {
+        const auto* s = glGetString(name);
+        return s != nullptr ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
+    };
+    impl->info.platform = impl->context->platform();
+    impl->info.gl_vendor = text(GL_VENDOR);
+    impl->info.gl_renderer = text(GL_RENDERER);
+    impl->info.gl_version = text(GL_VERSION);
+    if (major * 10 + minor < 45)
+        return fail("OpenGL: version " + impl->info.gl_version + " on " + impl->info.gl_renderer +
+                    "; Drape needs 4.5 core");
+    if (auto ok = impl->create_programs(); !ok) return fail(ok.error().message);
+    if (auto ok = impl->create_framebuffers(); !ok) return fail(ok.error().message);
+    impl->create_sphere();
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
+}
+
+Camera& Renderer::camera() noexcept { return m_impl->camera; }
+const Camera& Renderer::camera() const noexcept { return m_impl->camera; }
+const RenderSettings& Renderer::settings() const noexcept { return m_impl->settings; }
+const RendererInfo& Renderer::info() const noexcept { return m_impl->info; }
+int Renderer::width() const noexcept { return m_impl->settings.width; }
+int Renderer::height() const noexcept { return m_impl->settings.height; }
+void Renderer::set_show_ellipsoids(bool show) noexcept { m_impl->show_ellipsoids = show; }
+bool Renderer::show_ellipsoids() const noexcept { return m_impl->show_ellipsoids; }
+
+void Renderer::draw_scene(Registry& registry) {
+    if (!m_impl->context->make_current()) {
+        m_impl->frame_error = "EGL: cannot make the renderer's context current";
+        return;
+    }
+    m_impl->draw(registry);
+}
+
+Result<void> Renderer::read_pixels(Image& into) {
+    Impl& r = *m_impl;
+    if (!r.frame_error.empty()) return fail("render: " + r.frame_error);
+    if (!r.drawn) return fail("render: read_pixels before any frame was drawn");
+    if (!r.context->make_current()) return fail("EGL: cannot make the renderer's context current");
+    const int w = r.settings.width, h = r.settings.height;
+    const std::size_t row = std::size_t(w) * 4;
+    r.readback.resize(row * std::size_t(h));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r.read_fbo());
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, r.readback.data());
+    if (const GLenum error = glGetError(); error != GL_NO_ERROR)
+        return fail("OpenGL: glReadPixels failed (GL error " + std::to_string(error) + ")");
+    into.width = w;
+    into.height = h;
+    into.rgba.resize(row * std::size_t(h));
+    for (int y = 0; y < h; ++y)  // GL's rows start at the bottom; Image's at the top
+        std::memcpy(into.rgba.data() + std::size_t(y) * row, r.readback.data() + std::size_t(h - 1 - y) * row, row);
+    return {};
+}
+
+Result<Image> Renderer::read_pixels() {
+    Image image;
+    if (auto ok = read_pixels(image); !ok) return fail(ok.error().message);
+    return image;
+}
+
+Result<void> Renderer::present() {
+    Impl& r = *m_impl;
+    if (!r.context->make_current()) return fail("EGL: cannot make the renderer's context current");
+    if (!r.frame_error.empty()) return fail("render: " + r.frame_error);
+    if (!r.context->has_window()) {
+        glFinish();
+        return {};
+    }
+    const int w = r.settings.width, h = r.settings.height;
+    glBlitNamedFramebuffer(r.read_fbo(), 0, 0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    return r.context->swap_buffers();
+}
+
+bool Renderer::poll_events(InputState& input) {
+    input.clear();
+    if (!m_impl->window) return true;
+    const bool open = m_impl->window->poll(input);
+    if (input.orbit_dx_px != 0 || input.orbit_dy_px != 0) m_impl->camera.orbit(input.orbit_dx_px, input.orbit_dy_px);
+    if (input.zoom_steps != 0) m_impl->camera.zoom(input.zoom_steps);
+    return open;
+}
+
+void Renderer::finish() {
+    if (m_impl->context->make_current()) glFinish();
+}
+
+}  // namespace drape

@@ -1,0 +1,98 @@
+// Drape's renderer: an OpenGL 4.5 core context through EGL, off-screen or in an X11 window.
+//
+// Off-screen it uses Mesa's surfaceless platform (EGL_MESA_platform_surfaceless) and falls
+// back to the EGL device platform (EGL_EXT_platform_device); no display or GPU is needed
+// (Mesa's llvmpipe renders on the CPU). In a window it uses an EGL window surface on X11.
+// Either way a frame is drawn into a framebuffer object (4x MSAA by default), resolved,
+// then read back (`read_pixels`) or shown (`present`).
+//
+// This header holds no EGL or GL type, so code outside engine/render builds the same with
+// or without the render module. One Renderer owns one context; it makes it current on the
+// calling thread before each GL call, so use a Renderer from one thread at a time.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "engine/core/error.hpp"
+#include "engine/core/math.hpp"
+#include "engine/core/registry.hpp"
+#include "engine/render/camera.hpp"
+#include "engine/render/image.hpp"
+#include "engine/render/input.hpp"
+
+namespace drape {
+
+enum class RenderTarget : std::uint8_t {
+    offscreen,  ///< EGL surfaceless (or device) platform, no display needed.
+    window,     ///< An X11 window of the requested size (needs DISPLAY).
+};
+
+struct RenderSettings {
+    int width = 1280;                      ///< px, 16..8192.
+    int height = 720;                      ///< px, 16..8192.
+    RenderTarget target = RenderTarget::offscreen;
+    int msaa_samples = 4;                  ///< 0 or 1: off; otherwise 2, 4, 8 (capped by the driver).
+    Vec3 clear_color = Vec3(0.58f, 0.66f, 0.76f);  ///< Sky, linear RGB.
+    std::string window_title = "Drape";
+    bool vsync = false;                    ///< Window only: wait for the display's refresh in present().
+};
+
+/// Checks settings; the error names the field.
+[[nodiscard]] Result<void> validate(const RenderSettings& settings);
+
+/// What the context turned out to be (for logs and reports).
+struct RendererInfo {
+    std::string platform;      ///< "surfaceless", "device" or "x11".
+    std::string gl_vendor;
+    std::string gl_renderer;   ///< e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
+    std::string gl_version;
+    int msaa_samples = 0;      ///< Samples actually used (0 = off).
+};
+
+class Renderer {
+public:
+    /// Opens the context and the frame buffers. Fails with one clear message when there is
+    /// no display (window), no EGL, no OpenGL 4.5 core, or a shader does not compile.
+    [[nodiscard]] static Result<std::unique_ptr<Renderer>> create(const RenderSettings& settings);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    [[nodiscard]] Camera& camera() noexcept;
+    [[nodiscard]] const Camera& camera() const noexcept;
+    [[nodiscard]] const RenderSettings& settings() const noexcept;
+    [[nodiscard]] const RendererInfo& info() const noexcept;
+    [[nodiscard]] int width() const noexcept;
+    [[nodiscard]] int height() const noexcept;
+
+    void set_show_ellipsoids(bool show) noexcept;
+    [[nodiscard]] bool show_ellipsoids() const noexcept;
+
+    /// Draws the registry's scene into the frame: every SkinnedMesh (lit, one colour per
+    /// submesh), every Garment (double-sided, normals from its particles), the ground with
+    /// contact shadows, and the EllipsoidColliders when shown. The render system calls this
+    /// once per frame. Bad data (an index past the vertices, a size mismatch) skips that
+    /// entity and is reported by the next read_pixels()/present().
+    void draw_scene(Registry& registry);
+
+    /// The last drawn frame, RGBA8, top row first. Also reports an error of the last draw.
+    [[nodiscard]] Result<Image> read_pixels();
+    /// The same into an existing image (no allocation once it has the right size).
+    [[nodiscard]] Result<void> read_pixels(Image& into);
+    /// Window: shows the last drawn frame (swap buffers). Off-screen: waits for the GPU.
+    [[nodiscard]] Result<void> present();
+    /// Window: gathers key and mouse events (mouse drags orbit the camera, the wheel zooms)
+    /// and returns false once the window is closed. Off-screen: clears `input`, returns true.
+    bool poll_events(InputState& input);
+
+    /// Blocks until the GPU finished every command given so far (for timing).
+    void finish();
+
+private:
+    struct Impl;
+    explicit Renderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace drape

@@ -1,0 +1,35 @@
+// The render system: draws the scene through a Renderer once per frame (phase render).
+//
+// Reads SkinnedMesh (gates the run); reads Garment, EllipsoidCollider, Transform and
+// Character when present. Before drawing it moves the camera's target to the first
+// character (the one with the lowest entity index) when `Camera::follow` is set.
+#pragma once
+
+#include <vector>
+
+#include "engine/core/error.hpp"
+#include "engine/core/registry.hpp"
+#include "engine/core/scheduler.hpp"
+#include "engine/render/renderer.hpp"
+
+namespace drape {
+
+/// The render system. The renderer must outlive the scheduler that runs it.
+[[nodiscard]] System make_render_system(Renderer& renderer);
+
+/// Where the camera should look for the first character: the centre of its skinned
+/// vertices' bounds horizontally, `camera.follow_height_ratio` of its height above its
+/// lowest point. Nullopt when the scene has no skinned mesh with vertices.
+[[nodiscard]] std::optional<Vec3> follow_target(Registry& registry, const Camera& camera);
+
+/// Moves `camera.target` toward follow_target() with the camera's smoothing time constant
+/// over `dt_s` (snaps on the first call, when dt_s <= 0, or when the constant is 0).
+void update_follow_camera(Camera& camera, Registry& registry, double dt_s);
+
+/// Renders the registry's current state `frames` times through the render system's path
+/// (camera follow + draw + resolve); with `readback`, each frame is also read back to the
+/// CPU as an export would. Returns the wall time of each frame in ms, in order.
+[[nodiscard]] Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& registry, int frames,
+                                                            bool readback = true);
+
+}  // namespace drape
