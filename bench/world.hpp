@@ -1,0 +1,36 @@
+// The worlds the benchmarks run: the default avatar walking in place with a garment, built
+// through the game's scene description exactly as `drape play` builds its scene.
+#pragma once
+
+#include <vector>
+
+#include "components/garment.hpp"
+#include "engine/core/error.hpp"
+#include "game/scene.hpp"
+
+namespace drape::bench {
+
+/// What to build.
+struct WorldSpec {
+    int walkers = 1;                                   ///< Characters, in a grid 1.5 m apart.
+    GarmentType garment = GarmentType::skirt;
+    ClothModel model = ClothModel::simplified;
+    CollisionMode collision = CollisionMode::candidate_lists;
+    int particles = 0;                                 ///< 0: the builder's default.
+    int substeps = 0;                                  ///< 0: the cloth's stability rule.
+    double time_scale = 1;
+    int threads = 1;
+    bool profile = true;                               ///< Time every system run.
+    bool in_place = true;                              ///< false: root motion moves the walkers.
+};
+
+/// The scene description of a spec (default avatar, its walk, in place).
+[[nodiscard]] SceneDescription scene_for(const WorldSpec& spec);
+
+/// Builds a headless world; the error says what is missing (e.g. the avatar file).
+[[nodiscard]] Result<World> build_bench_world(const WorldSpec& spec);
+
+/// The first garment of a world.
+[[nodiscard]] Garment& first_garment(World& world);
+
+}  // namespace drape::bench
