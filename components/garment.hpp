@@ -65,7 +65,9 @@ struct GarmentTopology {
     std::vector<std::uint32_t> triangles;   ///< Render triangles over the particle grid.
 
     // Layer-1 springs (method §3.2, §4.1).
-    SpringPhase warp1;       ///< Warp springs between layer-1 particles: the simplified model's only forces.
+    SpringPhase warp1;       ///< Warp springs between layer-1 particles.
+    SpringPhase weft1;       ///< Simplified only: stretch springs between neighbouring layer-1 particles along the weft
+                             ///< (paper §2.3 (2): layer-1 particles are joined by stretch springs only).
     // Layer 2 and the classic model.
     SpringPhase warp2;       ///< Warp springs on layer-2 lines.
     SpringPhase weft;        ///< Weft (structural) springs between neighbouring lines.
@@ -175,6 +177,7 @@ struct Garment {
 
     // Scratch and caches the systems keep between substeps (no allocation per step).
     Matrix3X force;                          ///< Spring forces, N.
+    Matrix3X x_start;                        ///< Positions at the start of the substep (contact velocities).
     Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
     Matrix3X normals;                        ///< Layer-1 normals for weft placement.
     Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.

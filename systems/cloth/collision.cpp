@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include "systems/cloth/body.hpp"
 
@@ -11,10 +12,25 @@ namespace drape {
 namespace {
 
 // A pushed-out particle sits this fraction outside the surface so that float rounding
-// cannot leave it a hair inside (0.3 um on a 30 cm ellipsoid).
-constexpr Real surface_clearance = Real(1e-6);
-// Re-test rounds for a particle pushed between overlapping ellipsoids.
-constexpr int max_retest_rounds = 8;
+// cannot leave it a hair inside: 1e-6 of the radius, more far from the world origin where
+// a float position has fewer digits (at 10 m, 1 ulp is ~1 um).
+inline Real surface_clearance(const EllipsoidFrame& f) {
+    const Real reach = f.center.cwiseAbs().maxCoeff() + f.radii_m.maxCoeff();
+    return Real(1e-6) + 8 * std::numeric_limits<Real>::epsilon() * reach / f.radii_m.minCoeff();
+}
+// Re-test rounds for a particle pushed between overlapping ellipsoids, before the fallback.
+constexpr int max_retest_rounds = 4;
+
+// Distance along the ray o + t d (|d| = 1) at which it leaves the ellipsoid; -inf if it misses.
+// In double: the quadratic loses digits when the ray is nearly tangent.
+inline Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
+    const Eigen::Vector3d oo = to_unit_sphere(f, o).cast<double>();
+    const Eigen::Vector3d dd = (f.to_unit * d).cast<double>();
+    const double a = dd.squaredNorm(), b = 2 * oo.dot(dd), c = oo.squaredNorm() - 1;
+    const double disc = b * b - 4 * a * c;
+    if (disc < 0 || a <= 0) return -std::numeric_limits<Real>::infinity();
+    return static_cast<Real>((-b + std::sqrt(disc)) / (2 * a));
+}
 
 template <class F>
 inline void for_each_bit(std::uint64_t bits, F&& f) {
@@ -44,7 +60,7 @@ void push_out(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x, Vec3& v) {
         y = Vec3::Unit(axis);
         length = 1;
     }
-    const Vec3 y_surface = y * ((1 + surface_clearance) / length);
+    const Vec3 y_surface = y * ((1 + surface_clearance(f)) / length);
     x = f.center + f.rotation * f.radii_m.cwiseProduct(y_surface);
     const Vec3 normal = (f.to_unit.transpose() * y_surface).normalized();
     const Vec3 surface_velocity = body_velocity_at(f, x);
@@ -79,7 +95,8 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
 
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
-                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected) {
+                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected,
+                                  const Matrix3X* x_start, Real h) {
     CollisionResult r;
     const Eigen::Index n = x.cols();
     last_collided.resize(static_cast<std::size_t>(n), 0);
@@ -133,7 +150,38 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                     moved = respond(e) || moved;
                 });
             }
-            if (moved) ++r.unresolved;
+            if (moved) {
+                // Still between overlapping ellipsoids: leave along the centre line of the
+                // last one hit, past every ellipsoid of the list that line crosses. Each is
+                // convex, so beyond its exit point the line stays outside it.
+                const EllipsoidFrame& f = frames[static_cast<std::size_t>(std::countr_zero(hits))];
+                Vec3 d = xp - f.center;
+                const Real length = d.norm();
+                d = length > Real(1e-9) ? Vec3(d / length) : Vec3(f.rotation.col(0));
+                Real exit = 0;
+                for_each_bit(list, [&](int e) {
+                    const EllipsoidFrame& g = frames[static_cast<std::size_t>(e)];
+                    const Real t = ray_exit(g, f.center, d);
+                    exit = std::max(exit, t + 2 * surface_clearance(g) * g.radii_m.maxCoeff());
+                });
+                xp = f.center + d * exit;
+                Real depth = 0;
+                for_each_bit(list, [&](int e) {
+                    ++r.tests;
+                    depth = std::max(depth, penetration_depth(frames[static_cast<std::size_t>(e)], xp));
+                });
+                if (depth > Real(1e-5)) ++r.unresolved;
+            }
+        }
+        if (x_start != nullptr && h > 0) {
+            // Velocity of the whole move, then no normal velocity relative to any surface touched.
+            vp = (xp - x_start->col(p)) / h;
+            for_each_bit(last_collided[pi], [&](int e) {
+                const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+                const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, xp)).normalized();
+                const Vec3 surface_velocity = body_velocity_at(f, xp);
+                vp -= (vp - surface_velocity).dot(normal) * normal;
+            });
         }
         x.col(p) = xp;
         v.col(p) = vp;
@@ -152,7 +200,7 @@ DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass, std
     return out;
 }
 
-CollisionResult collide_garment(Garment& g, DetectedPairs* detected) {
+CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
     const Eigen::Index n = g.x.cols();
     const std::size_t e_count = g.frames.size();
     const std::vector<std::uint64_t>* lists = nullptr;
@@ -209,7 +257,9 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected) {
         lists = &g.candidates;
     }
 
-    const CollisionResult r = collide_particles(g.x, g.v, g.inv_mass, g.frames, lists, g.last_collided, detected);
+    const bool have_start = h > 0 && g.x_start.cols() == n;
+    const CollisionResult r = collide_particles(g.x, g.v, g.inv_mass, g.frames, lists, g.last_collided, detected,
+                                                have_start ? &g.x_start : nullptr, h);
     g.counters.frame_collision_tests += r.tests;
     g.counters.collision_tests += r.tests;
     g.counters.frame_collisions += r.collisions;

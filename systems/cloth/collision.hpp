@@ -18,6 +18,9 @@
 //      velocity component along the surface normal relative to the surface's own motion
 //      (the ellipsoid is inelastic). Overlapping ellipsoids can push a particle into a
 //      neighbour, so the particle's list is re-tested until it is outside all of them.
+//      Within a substep, a particle that collided takes the velocity of its whole move,
+//      (x_end - x_start) / h, before the normal component is removed: the constraints
+//      and the push-out then cannot pump energy into a particle held against the body.
 // Pinned particles are skipped: they are on the skin by construction (method §3.5).
 #pragma once
 
@@ -60,10 +63,12 @@ struct CollisionResult {
 using DetectedPairs = std::vector<std::uint64_t>;
 
 /// Steps 2-3 for particles [0, cols). `candidates` null = brute force. `last_collided`
-/// is read (tested first) and rewritten.
+/// is read (tested first) and rewritten. With `x_start` (positions at the start of the
+/// substep of length h_s), a colliding particle's velocity is recomputed from its move.
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
-                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr);
+                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr,
+                                  const Matrix3X* x_start = nullptr, Real h_s = 0);
 
 /// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
 [[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,
@@ -71,6 +76,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
 
 /// Whole garment: checks the lists' displacement bound (rebuilding when spent), then
 /// collides in the garment's mode and adds to its counters. Frames must be current.
-CollisionResult collide_garment(Garment& garment, DetectedPairs* detected = nullptr);
+/// h_s > 0: velocities of colliding particles from their move since `garment.x_start`.
+CollisionResult collide_garment(Garment& garment, DetectedPairs* detected = nullptr, Real h_s = 0);
 
 }  // namespace drape

@@ -371,6 +371,9 @@ Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(int lines_in,
         for (std::uint32_t row = 0; row + 1 < m; ++row) add(is_layer1(line) ? t->warp1 : t->warp2, line, row, line, row + 1);
     for (std::uint32_t row = 0; row < m; ++row)
         for (std::uint32_t line = 0; line < weft_lines; ++line) add(t->weft, line, row, (line + 1) % n, row);
+    for (std::uint32_t row = 0; row < m; ++row)
+        for (std::uint32_t line = 0; line < n; line += stride)
+            if (closed || line + stride < n) add(t->weft1, line, row, (line + stride) % n, row);
     for (std::uint32_t line = 0; line < weft_lines; ++line)
         for (std::uint32_t row = 0; row + 1 < m; ++row) {
             add(t->shear, line, row, (line + 1) % n, row + 1);

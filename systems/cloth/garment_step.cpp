@@ -45,6 +45,7 @@ void integrate_garment(const Registry& registry, Garment& g, const FrameContext&
         update_pin_targets(registry, g, false);
     }
 
+    g.x_start = g.x;  // no allocation once sized
     // The body part carrying the garment at the start of the substep (method §3.3).
     BodyMotion body;
     if (g.anchor >= 0 && static_cast<std::size_t>(g.anchor) < g.colliders.size()) {
@@ -60,6 +61,7 @@ void integrate_garment(const Registry& registry, Garment& g, const FrameContext&
         const Real scale = t.layer1_mass_scale;
         g.force.leftCols(count).setZero();
         add_spring_forces(t.warp1, m.stretch_k_N_m * scale, g.x, g.force);
+        add_spring_forces(t.weft1, m.stretch_k_N_m, g.x, g.force);
         integrate_particles(g.x, g.v, g.inv_mass, g.force, count, scale, m.drag_N_s_m, body, gravity, h);
     } else {
         g.force.setZero();
@@ -81,7 +83,11 @@ void constrain_garment(Garment& g, const FrameContext& ctx) {
     o.iterations = g.material.strain_iterations;
     o.h_s = static_cast<Real>(ctx.h_s);
     if (g.model == ClothModel::simplified) {
-        // §4.1: warp of layer 1.
+        // §4.1: layer 1, the weft springs between its lines symmetric only, then the warp
+        // with its ordered pass last so that the 10 % bound holds exactly on the warp.
+        StrainLimitOptions weft1 = o;
+        weft1.ordered_pass = false;
+        limit_strain(t.weft1, g.x, g.v, g.movable, weft1);
         limit_strain(t.warp1, g.x, g.v, g.movable, o);
         // §4.2: layer 2 placed in its planes, then Provot with layer 1 held.
         compute_layer1_normals(t, g.x, g.normals);
@@ -107,10 +113,10 @@ std::uint64_t count_non_finite(const Garment& g) {
     return static_cast<std::uint64_t>((!g.x.array().isFinite()).count() + (!g.v.array().isFinite()).count());
 }
 
-void collide_garment_step(const Registry& registry, Garment& g, const FrameContext& ctx) {
+void collide_garment_step(const Registry& registry, Garment& g, const FrameContext& context) {
     prepare_garment(g);
-    update_frames(registry, g, Real(ctx.substep + 1) / Real(ctx.substeps));
-    const CollisionResult r = collide_garment(g);
+    update_frames(registry, g, Real(context.substep + 1) / Real(context.substeps));
+    const CollisionResult r = collide_garment(g, nullptr, static_cast<Real>(context.h_s));
     g.counters.unresolved += r.unresolved;
 
     // A NaN or infinity must not spread: report it once, count it, and start again from rest.

@@ -60,6 +60,7 @@ Real stable_step_s(const GarmentTopology& topology, const ClothMaterial& materia
     };
     if (simplified) {
         add(topology.warp1, material.stretch_k_N_m * scale);
+        add(topology.weft1, material.stretch_k_N_m);
     } else {
         add(topology.warp1, material.stretch_k_N_m);
         add(topology.warp2, material.stretch_k_N_m);

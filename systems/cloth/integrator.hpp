@@ -1,8 +1,9 @@
 // Forces and time integration of the mass-spring garment (method §3.3, §3.4).
 //
 // Step order of one substep (cloth integration system):
-//   1. F_springs: Hooke forces of the stretch springs (simplified: warp springs between
-//      layer-1 particles; classic: warp, weft, shear and bend springs).
+//   1. F_springs: Hooke forces of the stretch springs (simplified: the stretch springs
+//      joining layer-1 particles, along the warp and to the next layer-1 line along the
+//      weft; classic: warp, weft, shear and bend springs on the full grid).
 //   2. Per free particle, the force of paper eq. 2 in the frame of the body (the anchor
 //      collider translating with velocity v_b and acceleration a_b at the particle):
 //          F = -m a_b - k (v_b + a_b h/2) - k v_rel + m g + F_springs,  v_rel = v - v_b.
