@@ -468,10 +468,21 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
         if (v == nullptr) continue;
         const std::string p = f.path(spec.name);
         const double value = spec.integer ? read_int(r, p, *v, static_cast<long long>(spec.min), static_cast<long long>(spec.max))
-                                          : read_real(r, p, *v, spec.min, spec.max, spec.min == 0 ? Bound::open : Bound::closed);
+                                          : read_real(r, p, *v, spec.min, spec.max, spec.min_exclusive ? Bound::open : Bound::closed);
         g.parameters.push_back({std::string(spec.name), value});  // in table order
     }
     f.finish();
+    // The grid size, however it was given.
+    auto param = [&](std::string_view name) -> const GarmentParameter* {
+        for (const GarmentParameter& p : g.parameters)
+            if (p.name == name) return &p;
+        return nullptr;
+    };
+    if (param("particles") && (param("warp_lines") || param("particles_per_line")))
+        r.fail_at(f.path("particles"), "give either particles or warp_lines and particles_per_line, not both");
+    if (const GarmentParameter *w = param("warp_lines"), *m = param("particles_per_line"); w && m && w->value * m->value > max_scene_particles)
+        r.fail_at(f.path("warp_lines"), cat("warp_lines x particles_per_line = ", number_text(w->value * m->value),
+                                            " particles, more than ", std::to_string(max_scene_particles)));
     return g;
 }
 
@@ -568,13 +579,33 @@ OrderedJson vec(const Vec3& v) { return OrderedJson::array({v.x(), v.y(), v.z()}
 }  // namespace
 
 const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type) {
-    // Mirrors SkirtParams / DressParams (systems/cloth/garment_builder.hpp).
-    static const std::vector<GarmentParameterSpec> skirt = {
-        {"particles", 16, max_scene_particles, true, "target particle count of the grid (the paper's skirt: 837)"},
+    // Mirrors SkirtParams, DressParams and ClothMaterial (systems/cloth/garment_builder.hpp,
+    // components/garment.hpp). The builder checks the combinations (validate(SkirtParams)).
+    auto shared = [](std::string_view ring_fraction, std::string_view ring_height) {
+        return std::vector<GarmentParameterSpec>{
+            {"particles", 16, max_scene_particles, false, true, "target particle count; sets warp_lines and particles_per_line"},
+            {"warp_lines", 3, 10000, false, true, "lines around the body (a multiple of weft_stride)"},
+            {"particles_per_line", 2, 10000, false, true, "particles down each line"},
+            {"weft_stride", 1, 16, false, true, "every weft_stride-th line is integrated (method 3.2)"},
+            {"length_m", 0, 10, true, false, "from the ring to the hem along the cloth"},
+            {"flare_deg", 0, 80, false, false, "cone half-angle from vertical"},
+            {"ease_m", 0, 1, false, false, "gap between body outline and cloth"},
+            {ring_fraction, 0, 1, true, false, "ring height / body height"},
+            {ring_height, 0, 10, false, false, "> 0: ring height above the body's lowest point"},
+            {"torso_radius_fraction", 0, 1, true, false, "colliders farther from the axis (x height) are not outline"},
+            {"fitting_rows", 1, 1000, false, true, "rows pinned to the body (method 3.5)"},
+            {"mass_kg", 0, 100, true, false, "whole garment"},
+            {"stretch_k_N_m", 0, 1e7, true, false, "per stretch spring"},
+            {"shear_k_N_m", 0, 1e7, true, false, "classic model only"},
+            {"bend_k_N_m", 0, 1e7, true, false, "classic model only"},
+            {"drag_N_s_m", 0, 100, false, false, "air drag per particle (method 3.3 k)"},
+            {"strain_limit", 0, 10, true, false, "Provot: largest relative over-stretch (method 4.1)"},
+            {"strain_iterations", 0, 100, false, true, "Provot passes"},
+            {"candidate_margin_m", 0, 1, false, false, "candidate lists: reach beyond the surface (method 5)"},
+        };
     };
-    static const std::vector<GarmentParameterSpec> dress = {
-        {"particles", 16, max_scene_particles, true, "target particle count of the grid"},
-    };
+    static const std::vector<GarmentParameterSpec> skirt = shared("waist_height_fraction", "waist_height_m");
+    static const std::vector<GarmentParameterSpec> dress = shared("shoulder_height_fraction", "shoulder_height_m");
     return type == GarmentType::skirt ? skirt : dress;
 }
 

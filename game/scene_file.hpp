@@ -128,13 +128,15 @@ struct SceneDescription {
 
 /// A numeric garment parameter a scene may set: its name, range and meaning.
 struct GarmentParameterSpec {
-    std::string_view name;
-    double min, max;                     ///< Inclusive.
+    std::string_view name;               ///< A field of SkirtParams / DressParams / ClothMaterial, or "particles".
+    double min, max;                     ///< Range; max inclusive.
+    bool min_exclusive;                  ///< true: (min, max]; false: [min, max].
     bool integer;
     std::string_view doc;
 };
 
-/// The parameters a garment type accepts in a scene file.
+/// The parameters a garment type accepts in a scene file (docs/scenes.md lists them).
+/// "particles" is a target count that chooses warp_lines and particles_per_line.
 [[nodiscard]] const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type);
 
 /// Upper bound on particles per garment accepted from a scene.

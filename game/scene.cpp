@@ -1,0 +1,366 @@
+#include "game/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <unistd.h>
+
+#include <tbb/global_control.h>
+
+#include "components/character.hpp"
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "components/skeleton.hpp"
+#include "components/skinned_mesh.hpp"
+#include "components/transform.hpp"
+#include "engine/assets/character_import.hpp"
+#include "systems/character/character_systems.hpp"
+#include "systems/character/spawn.hpp"
+#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth/garment_builder.hpp"
+
+#ifdef DRAPE_HAVE_RENDER
+#include "engine/render/renderer.hpp"
+#include "systems/render_system.hpp"
+#endif
+
+namespace drape {
+
+namespace fs = std::filesystem;
+
+bool render_available() noexcept {
+#ifdef DRAPE_HAVE_RENDER
+    return true;
+#else
+    return false;
+#endif
+}
+
+fs::path asset_dir() {
+    std::error_code ec;
+    auto has_avatar = [&](const fs::path& dir) { return fs::is_regular_file(dir / "avatar.glb", ec); };
+    if (const char* env = std::getenv("DRAPE_ASSETS"); env != nullptr && *env != '\0') return fs::path(env);
+    if (has_avatar("assets")) return fs::absolute("assets", ec);
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec)
+        for (const fs::path& candidate : {exe.parent_path() / "../assets", exe.parent_path() / "../share/drape/assets"})
+            if (has_avatar(candidate)) return candidate.lexically_normal();
+#ifdef DRAPE_SOURCE_ASSETS
+    return fs::path(DRAPE_SOURCE_ASSETS);
+#else
+    return fs::absolute("assets", ec);
+#endif
+}
+
+fs::path default_avatar_path() { return asset_dir() / "avatar.glb"; }
+
+SceneDescription sample_scene() {
+    SceneDescription scene;
+    scene.description = "Drape's sample scene: the default avatar walking in place in a skirt";
+    CharacterDescription avatar;
+    avatar.file = default_avatar_path();
+    avatar.clip = "Walk";
+    scene.characters.push_back(avatar);
+    GarmentDescription skirt;
+    skirt.type = GarmentType::skirt;
+    skirt.color = Vec3(0.75f, 0.12f, 0.18f);
+    scene.garments.push_back(skirt);
+    return scene;
+}
+
+namespace {
+
+constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
+
+Quat euler_deg(const Vec3& deg) {
+    return Quat(Eigen::AngleAxis<Real>(deg.y() * degrees, Vec3::UnitY()) * Eigen::AngleAxis<Real>(deg.x() * degrees, Vec3::UnitX()) *
+                Eigen::AngleAxis<Real>(deg.z() * degrees, Vec3::UnitZ()));
+}
+
+// A grid of about `particles` with the default grid's proportions; lines a multiple of the stride.
+void grid_for(int particles, int default_lines, int default_rows, int stride, int& lines, int& rows) {
+    const double aspect = double(default_rows) / double(default_lines);
+    const int s = std::max(1, stride);
+    lines = std::max(s * 2, static_cast<int>(std::lround(std::sqrt(particles / aspect) / s)) * s);
+    rows = std::max(2, static_cast<int>(std::lround(double(particles) / lines)));
+}
+
+// Scene parameters onto the builder's parameter struct (SkirtParams or DressParams).
+template <class Params>
+void apply_parameters(Params& p, const GarmentDescription& g, std::string_view ring_fraction, std::string_view ring_height,
+                      Real Params::*fraction_field, Real Params::*height_field) {
+    std::optional<int> particles;
+    for (const GarmentParameter& q : g.parameters) {
+        const Real r = static_cast<Real>(q.value);
+        const int i = static_cast<int>(std::lround(q.value));
+        const std::string_view n = q.name;
+        if (n == "particles") particles = i;
+        else if (n == "warp_lines") p.warp_lines = i;
+        else if (n == "particles_per_line") p.particles_per_line = i;
+        else if (n == "weft_stride") p.weft_stride = i;
+        else if (n == "length_m") p.length_m = r;
+        else if (n == "flare_deg") p.flare_deg = r;
+        else if (n == "ease_m") p.ease_m = r;
+        else if (n == ring_fraction) p.*fraction_field = r;
+        else if (n == ring_height) p.*height_field = r;
+        else if (n == "torso_radius_fraction") p.torso_radius_fraction = r;
+        else if (n == "fitting_rows") p.fitting_rows = i;
+        else if (n == "mass_kg") p.material.mass_kg = r;
+        else if (n == "stretch_k_N_m") p.material.stretch_k_N_m = r;
+        else if (n == "shear_k_N_m") p.material.shear_k_N_m = r;
+        else if (n == "bend_k_N_m") p.material.bend_k_N_m = r;
+        else if (n == "drag_N_s_m") p.material.drag_N_s_m = r;
+        else if (n == "strain_limit") p.material.strain_limit = r;
+        else if (n == "strain_iterations") p.material.strain_iterations = i;
+        else if (n == "candidate_margin_m") p.material.candidate_margin_m = r;
+    }
+    if (particles) grid_for(*particles, Params{}.warp_lines, Params{}.particles_per_line, p.weft_stride, p.warp_lines, p.particles_per_line);
+    p.model = g.model;
+    p.collision = g.collision;
+    if (g.color) p.color = *g.color;
+}
+
+// Applies the scene's collider overrides for one character (after spawn, before dressing).
+Result<void> apply_collider_overrides(World& world, const SceneDescription& scene, std::size_t index, const CharacterAsset& asset) {
+    Registry& registry = world.registry;
+    const Entity character = world.characters[index];
+    for (std::size_t k = 0; k < scene.colliders.size(); ++k) {
+        const ColliderOverride& o = scene.colliders[k];
+        if (o.character != static_cast<int>(index)) continue;
+        const std::string field = "colliders[" + std::to_string(k) + "].bone";
+        const int bone = asset.skeleton ? asset.skeleton->find(o.bone) : -1;
+        if (bone < 0) {
+            std::string bones;
+            if (asset.skeleton)
+                for (std::size_t b = 0; b < asset.skeleton->bone_names.size() && b < 12; ++b)
+                    bones += (b ? ", " : "") + asset.skeleton->bone_names[b];
+            return fail(located(o.where, field, "no bone \"" + o.bone + "\" in " + asset.source.string() + " (bones: " + bones +
+                                                    (asset.skeleton && asset.skeleton->size() > 12 ? ", ..." : "") + ")"));
+        }
+        std::vector<Entity> on_bone;
+        for (Entity e : colliders_of(registry, character))
+            if (const auto* c = registry.try_get<EllipsoidCollider>(e); c && c->bone == bone) on_bone.push_back(e);
+        if (o.remove) {
+            if (on_bone.empty()) return fail(located(o.where, field, "bone \"" + o.bone + "\" has no fitted ellipsoid to remove"));
+            for (Entity e : on_bone) registry.destroy(e);
+            continue;
+        }
+        if (on_bone.empty()) {  // a new ellipsoid on this bone
+            const Entity e = registry.create();
+            EllipsoidCollider& c = registry.emplace<EllipsoidCollider>(e);
+            c.character = character;
+            c.bone = bone;
+            on_bone.push_back(e);
+        }
+        for (Entity e : on_bone) {
+            EllipsoidCollider& c = registry.get<EllipsoidCollider>(e);
+            if (o.center_m) c.center = *o.center_m;
+            if (o.radii_m) c.radii_m = *o.radii_m;
+            if (o.rotation_deg) c.rotation = euler_deg(*o.rotation_deg);
+            c.initialised = false;
+        }
+    }
+    return {};
+}
+
+// Teleport guard (see scene.hpp): one fixed step's jump of a character's root beyond the
+// threshold resets the garments it wears around the body at its new place.
+System make_teleport_guard(double threshold_m, std::shared_ptr<TeleportLog> log) {
+    struct Last {
+        Entity entity;
+        Vec3 root;
+    };
+    auto last = std::make_shared<std::vector<Last>>();
+    System s;
+    s.name = "teleport_guard";
+    s.phase = Phase::skinning;
+    s.reads = components<Transform, Skeleton>();
+    s.writes = components<Garment>();
+    s.optional_reads = components<EllipsoidCollider>();
+    s.run = [threshold_m, log, last](Registry& registry, const FrameContext&) {
+        std::vector<Entity> jumped;
+        std::vector<Last> now;
+        registry.view<Transform, Skeleton>().each([&](Entity e, Transform& t, Skeleton& skeleton) {
+            const Vec3 local = skeleton.global.empty() ? Vec3::Zero() : Vec3(skeleton.global[0].translation());
+            const Vec3 root = t.matrix() * local;
+            now.push_back({e, root});
+            for (const Last& l : *last)
+                if (l.entity == e && (root - l.root).norm() > threshold_m) jumped.push_back(e);
+        });
+        *last = std::move(now);
+        if (jumped.empty()) return;
+        for (Entity character : jumped) {
+            ++log->teleports;
+            // The jump is no motion: the colliders must not carry its velocity into the cloth.
+            registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+                if (c.character != character) return;
+                c.previous_world = c.world;
+                c.velocity_m_s.setZero();
+                c.acceleration_m_s2.setZero();
+                c.angular_velocity_rad_s.setZero();
+            });
+            std::vector<Entity> worn;
+            registry.view<Garment>().each([&](Entity g, Garment& garment) {
+                if (garment.body == character) worn.push_back(g);
+            });
+            for (Entity g : worn) {
+                reset_garment(registry, g);
+                ++log->resets;
+            }
+        }
+    };
+    return s;
+}
+
+}  // namespace
+
+Result<World> build_world(const SceneDescription& scene, const WorldOptions& options) {
+    if (auto ok = validate(scene); !ok) return std::unexpected(ok.error());
+    SchedulerSettings settings;
+    settings.fixed_dt_s = scene.solver.fixed_dt_s;
+    settings.max_steps_per_frame = scene.solver.max_steps_per_frame;
+    settings.time_scale = scene.solver.time_scale;
+    auto scheduler = Scheduler::create(settings);
+    if (!scheduler) return std::unexpected(scheduler.error());
+
+    World world;
+    world.scene = scene;
+    world.scheduler = std::move(*scheduler);
+    if (scene.solver.threads > 0)
+        world.thread_limit = std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                                   static_cast<std::size_t>(scene.solver.threads));
+    world.scheduler.profiler().set_timing(options.profile);
+
+    // Characters (one import per file), then collider overrides.
+    std::map<fs::path, std::shared_ptr<const CharacterAsset>> assets;
+    for (std::size_t i = 0; i < scene.characters.size(); ++i) {
+        const CharacterDescription& c = scene.characters[i];
+        const std::string field = "characters[" + std::to_string(i) + "].file";
+        auto& asset = assets[c.file];
+        if (!asset) {
+            auto imported = import_character(c.file);
+            if (!imported) return fail(located(c.where, field, imported.error().message));
+            asset = *imported;
+        }
+        SpawnOptions spawn;
+        spawn.transform.position = c.position_m;
+        spawn.transform.rotation = c.rotation();
+        spawn.transform.scale = c.scale;
+        spawn.clip = c.clip;
+        spawn.speed = c.speed;
+        spawn.in_place = c.in_place;
+        if (!c.clip.empty()) {
+            if (auto clip = find_clip(*asset, c.clip); !clip)
+                return fail(located(c.where, "characters[" + std::to_string(i) + "].clip", clip.error().message));
+        }
+        auto entity = spawn_character(world.registry, asset, spawn);
+        if (!entity) return fail(located(c.where, "characters[" + std::to_string(i) + "]", entity.error().message));
+        world.characters.push_back(*entity);
+        if (auto ok = apply_collider_overrides(world, scene, i, *asset); !ok) return std::unexpected(ok.error());
+    }
+
+    // Systems: characters, teleport guard, cloth (+ fixed substeps), render.
+    add_character_systems(world.scheduler);
+    world.scheduler.add(make_teleport_guard(scene.solver.teleport_threshold_m, world.teleports));
+    add_cloth_systems(world.scheduler);
+    if (scene.solver.substeps > 0) {
+        const int n = scene.solver.substeps;
+        world.scheduler.set_substep_rule([n](Registry&, double) { return n; });
+    }
+    // The garment builders fit around placed colliders (overrides included): one skinning
+    // pass (skinning, colliders) places them before the first step.
+    world.scheduler.run_phase(world.registry, Phase::skinning, FrameContext{.fixed_dt_s = scene.solver.fixed_dt_s});
+
+    // Garments.
+    for (std::size_t i = 0; i < scene.garments.size(); ++i) {
+        const GarmentDescription& g = scene.garments[i];
+        const std::string field = "garments[" + std::to_string(i) + "]";
+        const Entity body = world.characters.at(static_cast<std::size_t>(g.character));
+        Result<Entity> garment = fail("");
+        if (g.type == GarmentType::skirt) {
+            SkirtParams p;
+            apply_parameters(p, g, "waist_height_fraction", "waist_height_m", &SkirtParams::waist_height_fraction,
+                             &SkirtParams::waist_height_m);
+            garment = attach_skirt(world.registry, body, p);
+        } else {
+            DressParams p;
+            apply_parameters(p, g, "shoulder_height_fraction", "shoulder_height_m", &DressParams::shoulder_height_fraction,
+                             &DressParams::shoulder_height_m);
+            garment = attach_dress(world.registry, body, p);
+        }
+        if (!garment) return fail(located(g.where, field, garment.error().message));
+        world.garments.push_back(*garment);
+    }
+    world.watch = GarmentWatch(world.registry, world.garments);
+    world.scheduler.profiler().reset();  // the profile is of played frames, not of the set-up pass
+
+    // Renderer.
+    if (options.render) {
+#ifdef DRAPE_HAVE_RENDER
+        RenderSettings rs;
+        rs.width = options.width;
+        rs.height = options.height;
+        rs.target = options.window ? RenderTarget::window : RenderTarget::offscreen;
+        auto renderer = Renderer::create(rs);
+        if (!renderer) return std::unexpected(renderer.error());
+        world.renderer = std::shared_ptr<Renderer>(std::move(*renderer));
+        Camera& camera = world.renderer->camera();
+        const CameraDescription& c = scene.camera;
+        camera.follow = c.follow;
+        camera.target = c.target_m;
+        camera.distance_m = c.distance_m;
+        camera.yaw_rad = c.yaw_deg * degrees;
+        camera.pitch_rad = c.pitch_deg * degrees;
+        camera.fov_y_rad = c.fov_deg * degrees;
+        world.scheduler.add(make_render_system(*world.renderer));
+#else
+        return fail("rendering: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
+#endif
+    }
+    return world;
+}
+
+Result<FrameReport> step_world(World& world, double frame_dt_s) {
+    if (std::isfinite(frame_dt_s) && frame_dt_s > world.scene.solver.max_frame_dt_s) frame_dt_s = world.scene.solver.max_frame_dt_s;
+    auto report = world.scheduler.tick(world.registry, frame_dt_s);
+    if (report) world.watch.sample(world.registry);
+    return report;
+}
+
+void reset_garments(World& world) {
+    for (Entity g : world.garments) {
+        reset_garment(world.registry, g);
+        ++world.teleports->resets;
+    }
+}
+
+void set_garment_model(World& world, ClothModel model) {
+    for (std::size_t i = 0; i < world.garments.size(); ++i) {
+        if (Garment* g = world.registry.try_get<Garment>(world.garments[i])) {
+            g->model = model;
+            g->stability_valid = false;
+        }
+        if (i < world.scene.garments.size()) world.scene.garments[i].model = model;
+    }
+}
+
+Result<void> set_time_scale(World& world, double scale) {
+    if (auto ok = world.scheduler.set_time_scale(scale); !ok) return ok;
+    world.scene.solver.time_scale = scale;
+    return {};
+}
+
+RunStats run_stats(const World& world) {
+    return make_run_stats(world.scheduler.profiler(), world.scheduler.settings().fixed_dt_s, world.watch, world.registry);
+}
+
+bool has_nonfinite(const World& world) {
+    for (Entity e : world.garments)
+        if (const Garment* g = world.registry.try_get<Garment>(e); g && (!g->x.allFinite() || !g->v.allFinite())) return true;
+    for (Entity e : world.characters)
+        if (const SkinnedMesh* m = world.registry.try_get<SkinnedMesh>(e); m && !m->positions.allFinite()) return true;
+    return false;
+}
+
+}  // namespace drape
