@@ -581,6 +581,18 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
 Result<std::size_t> find_clip(const CharacterAsset& character, std::string_view name_or_index) {
     for (std::size_t i = 0; i < character.clips.size(); ++i)
         if (character.clips[i]->name == name_or_index) return i;
+    // "Man_Walk" finds "HumanArmature|Man_Walk" (Blender's armature|action names) when unique.
+    std::optional<std::size_t> suffix_match;
+    int suffix_matches = 0;
+    for (std::size_t i = 0; i < character.clips.size(); ++i) {
+        const std::string& name = character.clips[i]->name;
+        const auto bar = name.rfind('|');
+        if (bar != std::string::npos && std::string_view(name).substr(bar + 1) == name_or_index) {
+            suffix_match = i;
+            ++suffix_matches;
+        }
+    }
+    if (suffix_matches == 1) return *suffix_match;
     std::size_t index = 0;
     const char* end = name_or_index.data() + name_or_index.size();
     if (!name_or_index.empty()) {

@@ -48,7 +48,8 @@ struct ImportOptions {
 [[nodiscard]] Result<std::shared_ptr<const AnimationClip>> import_bvh_motion(const std::filesystem::path& path,
                                                                              const SkeletonAsset& skeleton);
 
-/// A clip by exact name, else by index ("0", "3"). The error lists the clips there are.
+/// A clip by exact name, else by the part after the last '|' when unique ("Man_Walk" for
+/// "HumanArmature|Man_Walk"), else by index ("0", "3"). The error lists the clips there are.
 [[nodiscard]] Result<std::size_t> find_clip(const CharacterAsset& character, std::string_view name_or_index);
 
 /// The clip's motion bone and travel (AnimationClip::motion_bone, travel_m, travel_local)

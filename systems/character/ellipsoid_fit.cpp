@@ -178,10 +178,14 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
             top = static_cast<std::size_t>(skeleton.parents[top]);
         if (top != b) move(b, top);
     }
+    // Siblings join only when their joints nearly coincide (palm bones fanning out of one
+    // wrist), never a left and a right foot that hang from the same root.
+    const Real joint_near = Real(0.08) * height_m;
     for (std::size_t b = 0; b < bones; ++b) {
         if (clusters[b].empty() || !extremity(region_of(b))) continue;
         for (std::size_t s = b + 1; s < bones; ++s)
-            if (!clusters[s].empty() && skeleton.parents[s] == skeleton.parents[b] && region_of(s) == region_of(b))
+            if (!clusters[s].empty() && skeleton.parents[s] == skeleton.parents[b] && region_of(s) == region_of(b) &&
+                (frame[s].translation() - frame[b].translation()).norm() < joint_near)
                 move(s, b);
     }
 

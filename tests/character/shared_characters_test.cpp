@@ -37,6 +37,10 @@ TEST_P(SharedCharacter, ImportsWithClipsBonesNormalisedWeightsAndCoveringEllipso
     EXPECT_EQ(c.clips.size(), e.clips);
     auto walk = find_clip(c, e.walk);
     ASSERT_TRUE(walk) << walk.error().message;
+    if (const auto bar = std::string(e.walk).rfind('|'); bar != std::string::npos) {
+        EXPECT_EQ(find_clip(c, std::string(e.walk).substr(bar + 1)).value(), *walk);  // "Man_Walk"
+    }
+    ASSERT_TRUE(walk) << walk.error().message;
     EXPECT_NEAR(c.clips[*walk]->duration_s, e.walk_s, 0.01);
     EXPECT_GE(c.skin_bones, e.min_skin_bones);
     const MeshAsset& m = *c.mesh;
@@ -58,6 +62,11 @@ TEST_P(SharedCharacter, ImportsWithClipsBonesNormalisedWeightsAndCoveringEllipso
         EXPECT_LE(c.ellipsoids.size(), 20u);
         EXPECT_GE(c.hip_bone, 0);
         EXPECT_TRUE(std::any_of(c.ellipsoids.begin(), c.ellipsoids.end(), [](auto& s) { return s.region == BodyRegion::pelvis; }));
+        // One ellipsoid per hand and per foot: fingers merge, left and right do not.
+        auto count = [&](BodyRegion r) { return std::count_if(c.ellipsoids.begin(), c.ellipsoids.end(), [&](auto& s) { return s.region == r; }); };
+        EXPECT_EQ(count(BodyRegion::hand), 2);
+        EXPECT_EQ(count(BodyRegion::foot), 2);
+        EXPECT_EQ(count(BodyRegion::upper_leg), 2);
         // Standing on the ground, Y up: feet near the bottom, head at the top.
         EXPECT_NEAR(p.row(1).minCoeff(), 0.0f, 0.05f);
     }

@@ -1,0 +1,103 @@
+// Character reports: see character_report.hpp.
+#include "systems/character/character_report.hpp"
+
+#include <cstdio>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "systems/character/pose.hpp"
+
+namespace drape {
+namespace {
+
+std::string format(const char* fmt, auto... args) {
+    char buffer[512];
+    std::snprintf(buffer, sizeof buffer, fmt, args...);
+    return buffer;
+}
+
+std::size_t triangles(const Submesh& s) { return s.index_count / 3; }
+
+}  // namespace
+
+CoverageReport rest_pose_coverage(const CharacterAsset& c, double tolerance_m) {
+    std::vector<Affine3> global, skinning;
+    compose_pose(*c.skeleton, c.skeleton->rest_local, global);
+    skinning_matrices(*c.skeleton, global, skinning);
+    Matrix3X positions, normals;
+    skin_mesh(*c.mesh, skinning, Affine3::Identity(), positions, normals);
+    return measure_coverage(c.ellipsoids, global, positions, normals, tolerance_m);
+}
+
+std::string character_report_text(const CharacterAsset& c, const CoverageReport& r) {
+    const SkeletonAsset& s = *c.skeleton;
+    const MeshAsset& m = *c.mesh;
+    std::string out = c.source.string() + "\n";
+    out += format("  height      %.3f m (scale %.6g from %s)\n", double(c.height_m), c.scale, scale_source_name(c.scale_source));
+    out += format("  meshes      %zu, %zu vertices, %zu triangles\n", c.meshes.size(), m.vertex_count(), m.indices.size() / 3);
+    for (std::size_t i = 0; i < c.meshes.size(); ++i)
+        out += format("    %-28s %6u vertices %6zu triangles%s\n", c.meshes[i].name.c_str(), c.meshes[i].vertex_count,
+                      i < m.submeshes.size() ? triangles(m.submeshes[i]) : std::size_t(0),
+                      c.meshes[i].rigid ? "  (rigid, bound to its bone)" : "");
+    out += format("  bones       %zu in the skeleton, %d move vertices; hips: %s\n", s.size(), c.skin_bones,
+                  c.hip_bone >= 0 ? s.bone_names[std::size_t(c.hip_bone)].c_str() : "none found");
+    out += format("  clips       %zu\n", c.clips.size());
+    for (std::size_t i = 0; i < c.clips.size(); ++i) {
+        const AnimationClip& clip = *c.clips[i];
+        out += format("    [%zu] %-32s %7.3f s  %3zu channels", i, clip.name.c_str(), clip.duration_s, clip.channels.size());
+        if (clip.travel_m.norm() > 1e-3f) out += format("  travels %.2f m", double(clip.travel_m.norm()));
+        out += "\n";
+    }
+    out += format("  ellipsoids  %zu fitted\n", c.ellipsoids.size());
+    for (std::size_t i = 0; i < c.ellipsoids.size(); ++i) {
+        const EllipsoidShape& e = c.ellipsoids[i];
+        out += format("    %-20s %-10s radii %.3f %.3f %.3f m  bulge %.3f m\n", s.bone_names[std::size_t(e.bone)].c_str(),
+                      body_region_name(e.region), double(e.radii_m.x()), double(e.radii_m.y()), double(e.radii_m.z()),
+                      i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0);
+    }
+    out += format("  coverage    %.1f %% of %zu vertices inside or within %.0f mm (largest gap %.3f m)\n", 100 * r.coverage,
+                  r.vertices, 1000 * r.tolerance_m, r.max_gap_m);
+    out += format("  bulge       mean %.3f m, p95 %.3f m, max %.3f m out of the body\n", r.mean_bulge_m, r.p95_bulge_m, r.max_bulge_m);
+    return out;
+}
+
+std::string character_report_json(const CharacterAsset& c, const CoverageReport& r) {
+    using nlohmann::json;
+    const SkeletonAsset& s = *c.skeleton;
+    const MeshAsset& m = *c.mesh;
+    json j;
+    j["file"] = c.source.string();
+    j["height_m"] = c.height_m;
+    j["scale"] = c.scale;
+    j["scale_source"] = scale_source_name(c.scale_source);
+    j["vertices"] = m.vertex_count();
+    j["triangles"] = m.indices.size() / 3;
+    j["meshes"] = json::array();
+    for (std::size_t i = 0; i < c.meshes.size(); ++i)
+        j["meshes"].push_back({{"name", c.meshes[i].name}, {"vertices", c.meshes[i].vertex_count},
+                               {"triangles", i < m.submeshes.size() ? triangles(m.submeshes[i]) : 0}, {"rigid", c.meshes[i].rigid}});
+    j["bones"] = s.size();
+    j["skin_bones"] = c.skin_bones;
+    j["hip_bone"] = c.hip_bone >= 0 ? json(s.bone_names[std::size_t(c.hip_bone)]) : json(nullptr);
+    j["clips"] = json::array();
+    for (const auto& clip : c.clips)
+        j["clips"].push_back({{"name", clip->name}, {"duration_s", clip->duration_s}, {"channels", clip->channels.size()},
+                              {"travel_m", {clip->travel_m.x(), clip->travel_m.y(), clip->travel_m.z()}}});
+    j["ellipsoids"] = json::array();
+    for (std::size_t i = 0; i < c.ellipsoids.size(); ++i) {
+        const EllipsoidShape& e = c.ellipsoids[i];
+        j["ellipsoids"].push_back({{"bone", s.bone_names[std::size_t(e.bone)]},
+                                   {"region", body_region_name(e.region)},
+                                   {"center", {e.center.x(), e.center.y(), e.center.z()}},
+                                   {"rotation", {e.rotation.x(), e.rotation.y(), e.rotation.z(), e.rotation.w()}},
+                                   {"radii_m", {e.radii_m.x(), e.radii_m.y(), e.radii_m.z()}},
+                                   {"bulge_m", i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0}});
+    }
+    j["coverage"] = {{"share", r.coverage}, {"vertices", r.vertices}, {"covered", r.covered}, {"tolerance_m", r.tolerance_m},
+                     {"max_gap_m", r.max_gap_m}, {"mean_bulge_m", r.mean_bulge_m}, {"p95_bulge_m", r.p95_bulge_m},
+                     {"max_bulge_m", r.max_bulge_m}};
+    return j.dump(2) + "\n";
+}
+
+}  // namespace drape

@@ -1,0 +1,21 @@
+// What a character holds, for people (`drape inspect`) and for tools (`--json`).
+#pragma once
+
+#include <string>
+
+#include "engine/assets/character_asset.hpp"
+#include "systems/character/ellipsoid_fit.hpp"
+
+namespace drape {
+
+/// The fitted ellipsoids' coverage and bulge on the rest pose.
+[[nodiscard]] CoverageReport rest_pose_coverage(const CharacterAsset& character, double tolerance_m = 0.01);
+
+/// Human-readable report: meshes, vertices, bones, clips with durations, ellipsoids,
+/// coverage and height in metres.
+[[nodiscard]] std::string character_report_text(const CharacterAsset& character, const CoverageReport& coverage);
+
+/// The same as JSON (one object; keys documented in the text report's order).
+[[nodiscard]] std::string character_report_json(const CharacterAsset& character, const CoverageReport& coverage);
+
+}  // namespace drape
