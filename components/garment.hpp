@@ -79,6 +79,9 @@ struct GarmentTopology {
     std::vector<std::uint32_t> weft_left;      ///< Its layer-1 neighbour before it along the weft.
     std::vector<std::uint32_t> weft_right;     ///< Its layer-1 neighbour after it.
     std::vector<Real> weft_t;                  ///< Fraction of the way from left to right, (0, 1).
+    std::vector<Real> weft_rest_m;             ///< Mean rest length of the weft segments from left to right.
+    std::vector<std::uint32_t> weft_above;     ///< The particle before it on its warp line (nearer the pins), or UINT32_MAX.
+    std::vector<Real> weft_above_rest_m;       ///< Rest length of that warp spring.
     // Normal stencil of each layer-1 particle: n = (x[up] - x[down]) x (x[next] - x[prev]).
     std::vector<std::uint32_t> normal_up, normal_down, normal_prev, normal_next;
 

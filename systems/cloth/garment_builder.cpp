@@ -397,6 +397,11 @@ Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(int lines_in,
             t->weft_left.push_back(at(left, row));
             t->weft_right.push_back(at(right, row));
             t->weft_t.push_back(Real(line % stride) / Real(stride));
+            Real segments = 0;
+            for (std::uint32_t k = left; k != right; k = (k + 1) % n) segments += rest(k, row, (k + 1) % n, row);
+            t->weft_rest_m.push_back(segments / Real(stride));
+            t->weft_above.push_back(row > 0 ? at(line, row - 1) : std::numeric_limits<std::uint32_t>::max());
+            t->weft_above_rest_m.push_back(row > 0 ? rest(line, row - 1, line, row) : Real(0));
         }
     }
     // Normal stencil of every layer-1 particle, in particle order.

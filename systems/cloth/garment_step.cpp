@@ -89,15 +89,9 @@ void constrain_garment(Garment& g, const FrameContext& ctx) {
         weft1.ordered_pass = false;
         limit_strain(t.weft1, g.x, g.v, g.movable, weft1);
         limit_strain(t.warp1, g.x, g.v, g.movable, o);
-        // §4.2: layer 2 placed in its planes, then Provot with layer 1 held.
+        // §4.2: layer 2 placed in its planes from layer 1, its bulge limited (weft.hpp).
         compute_layer1_normals(t, g.x, g.normals);
-        place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, o.h_s);
-        StrainLimitOptions weft = o;
-        weft.plane_normal = &g.plane_normal;
-        weft.ordered_pass = false;
-        limit_strain(t.weft, g.x, g.v, g.movable_weft, weft);
-        weft.ordered_pass = true;
-        limit_strain(t.warp2, g.x, g.v, g.movable_weft, weft);
+        place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, o.h_s, o.limit);
     } else {
         StrainLimitOptions weft = o;
         weft.ordered_pass = false;

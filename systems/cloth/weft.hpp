@@ -6,9 +6,19 @@
 //      the plane through x_a spanned by the edge e = x_b - x_a and the average normal
 //      n = n_a + n_b has unit normal p = e x n / |e x n|;
 //      velocity: v = (1 - t) v_a + t v_b, projected onto the plane (v -= (v.p) p);
-//      position: x += h v, then projected onto the plane.
-//   3. Provot on the weft springs and on the warp springs of layer-2 lines with layer 1
-//      held still, moving layer-2 particles only within their planes (strain_limit.hpp).
+//      position: the particle has no mass and no state of its own along the weft: it sits
+//      at q = (1 - t) x_a + t x_b on the edge plus a bulge b along u = p x e/|e|, the
+//      in-plane direction across the edge. The bulge is what it had after the last
+//      substep (the collision pushes it out of the body), carried by the velocity:
+//      b = (x + h v - q) . u.
+//   3. Provot on the weft (§4.2 item 3): the bulge is the only free coordinate, so the
+//      correction is a clamp |b| <= beta / 2 with beta = sqrt(l^2 - (|e| / stride)^2),
+//      l = (1 + limit) x rest: each weft segment, whose along-edge part is |e| / stride,
+//      then stays within the limit whenever the layer-1 weft spring does; and, line by
+//      line from the pins outward, b is kept in the interval that holds the warp spring
+//      to the particle above within (1 + limit) x rest (a 1-D Provot correction).
+//   Layer-2 particles are listed line by line from the pins outward, so the particle
+//   above is always placed first.
 #pragma once
 
 #include "components/garment.hpp"
@@ -19,10 +29,10 @@ namespace drape {
 /// Step 1: unit normals of the layer-1 particles (columns [0, layer1_count) of `normals`).
 void compute_layer1_normals(const GarmentTopology& topology, const Matrix3X& x, Matrix3X& normals);
 
-/// Step 2: places the free layer-2 particles and writes each one's plane normal into
+/// Steps 2-3: places the free layer-2 particles and writes each one's plane normal into
 /// `plane_normal` (zero for particles without a plane).
 void place_weft(const GarmentTopology& topology, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,
-                Matrix3X& v, Matrix3X& plane_normal, Real h_s);
+                Matrix3X& v, Matrix3X& plane_normal, Real h_s, Real strain_limit = Real(0.10));
 
 /// Signed distance of layer-2 particle `k` (index into topology.weft_particle) from its
 /// plane at the current positions, m (for tests and diagnostics).
