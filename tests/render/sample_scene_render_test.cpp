@@ -1,0 +1,85 @@
+// The real sample scene rendered off-screen (Mesa): the image is not uniform, and the
+// skirt's colour and the avatar's skin appear where the camera projects them.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "components/garment.hpp"
+#include "components/skinned_mesh.hpp"
+#include "engine/render/renderer.hpp"
+#include "game/scene.hpp"
+
+namespace drape {
+namespace {
+
+struct Rgb {
+    int r, g, b;
+};
+
+Rgb pixel(const Image& image, int x, int y) {
+    const std::uint8_t* p = image.at(x, y);
+    return {p[0], p[1], p[2]};
+}
+
+// Share of pixels in a square of half-size `radius` around (x, y) for which `test` holds.
+template <class Test>
+double share_around(const Image& image, const ScreenPoint& at, int radius, Test test) {
+    int hits = 0, total = 0;
+    for (int y = static_cast<int>(at.y_px) - radius; y <= static_cast<int>(at.y_px) + radius; ++y)
+        for (int x = static_cast<int>(at.x_px) - radius; x <= static_cast<int>(at.x_px) + radius; ++x) {
+            if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
+            ++total;
+            hits += test(pixel(image, x, y)) ? 1 : 0;
+        }
+    return total ? double(hits) / total : 0.0;
+}
+
+TEST(SampleSceneRender, SkirtAndAvatarAppearWhereTheCameraPutsThem) {
+    WorldOptions options;
+    options.render = true;
+    options.width = 640;
+    options.height = 360;
+    auto world = build_world(sample_scene(), options);
+    ASSERT_TRUE(world) << world.error().message;
+    ASSERT_NE(world->renderer, nullptr);
+    for (int frame = 0; frame < 20; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    auto image = world->renderer->read_pixels();
+    ASSERT_TRUE(image) << image.error().message;
+    ASSERT_EQ(image->width, 640);
+    ASSERT_EQ(image->height, 360);
+
+    // Not uniform: sky, ground, body and cloth give many colours.
+    std::set<std::uint32_t> colours;
+    for (int y = 0; y < image->height; y += 4)
+        for (int x = 0; x < image->width; x += 4) {
+            const Rgb c = pixel(*image, x, y);
+            colours.insert(static_cast<std::uint32_t>(c.r << 16 | c.g << 8 | c.b));
+        }
+    EXPECT_GT(colours.size(), 100u);
+
+    const Camera& camera = world->renderer->camera();
+    // The skirt (red) around the projection of its centre.
+    const Garment& skirt = world->registry.get<Garment>(world->garments[0]);
+    const Vec3 skirt_centre = skirt.x.rowwise().mean();
+    const auto skirt_px = camera.project(skirt_centre, image->width, image->height);
+    ASSERT_TRUE(skirt_px.has_value());
+    const double red = share_around(*image, *skirt_px, 6, [](Rgb c) { return c.r > 2 * c.g && c.r > 2 * c.b && c.r > 60; });
+    EXPECT_GT(red, 0.5) << "skirt centre projects to (" << skirt_px->x_px << ", " << skirt_px->y_px << ")";
+
+    // The avatar's skin (warm, not the blue-grey sky or the grey ground) at its chest:
+    // 0.3 m below the top of the skinned body, at the body's horizontal centre.
+    const SkinnedMesh& body = world->registry.get<SkinnedMesh>(world->characters[0]);
+    Vec3 chest = body.positions.rowwise().mean();
+    chest.y() = body.positions.row(1).maxCoeff() - 0.3f;
+    const auto chest_px = camera.project(chest, image->width, image->height);
+    ASSERT_TRUE(chest_px.has_value());
+    const double skin = share_around(*image, *chest_px, 3, [](Rgb c) { return c.r > c.b + 15 && c.g > c.b; });
+    EXPECT_GT(skin, 0.5) << "chest projects to (" << chest_px->x_px << ", " << chest_px->y_px << ")";
+
+    // Far above the avatar there is sky: bluer than red.
+    const ScreenPoint top{static_cast<float>(image->width) / 2, 4, 0};
+    EXPECT_GT(share_around(*image, top, 3, [](Rgb c) { return c.b > c.r; }), 0.9);
+}
+
+}  // namespace
+}  // namespace drape
