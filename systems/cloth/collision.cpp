@@ -96,7 +96,7 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected,
-                                  const Matrix3X* x_start, Real h) {
+                                  const Matrix3X* x_start, Real h, Real list_slack) {
     CollisionResult r;
     const Eigen::Index n = x.cols();
     last_collided.resize(static_cast<std::size_t>(n), 0);
@@ -131,6 +131,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         if (hits == 0) continue;
 
         Vec3 vp = v.col(p);
+        const Vec3 x_detected = xp;
         auto respond = [&](int e) {
             const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
             const Vec3 y = to_unit_sphere(f, xp);
@@ -141,11 +142,15 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         };
         for_each_bit(hits & last, respond);
         for_each_bit(hits & ~last, respond);
-        if (std::popcount(list) > 1) {
+        // Pushed beyond what the list still covers: every ellipsoid may now be near.
+        const Real slack_sq = list_slack * list_slack;
+        std::uint64_t retest = (xp - x_detected).squaredNorm() > slack_sq ? active : list;
+        if (std::popcount(retest) > 1 || retest != list) {
             bool moved = true;
             for (int round = 0; round < max_retest_rounds && moved; ++round) {
                 moved = false;
-                for_each_bit(list, [&](int e) {
+                if ((xp - x_detected).squaredNorm() > slack_sq) retest = active;
+                for_each_bit(retest, [&](int e) {
                     ++r.tests;
                     moved = respond(e) || moved;
                 });
@@ -159,14 +164,23 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                 const Real length = d.norm();
                 d = length > Real(1e-9) ? Vec3(d / length) : Vec3(f.rotation.col(0));
                 Real exit = 0;
-                for_each_bit(list, [&](int e) {
+                for_each_bit(retest, [&](int e) {
                     const EllipsoidFrame& g = frames[static_cast<std::size_t>(e)];
                     const Real t = ray_exit(g, f.center, d);
                     exit = std::max(exit, t + 2 * surface_clearance(g) * g.radii_m.maxCoeff());
                 });
                 xp = f.center + d * exit;
+                if ((xp - x_detected).squaredNorm() > slack_sq && retest != active) {
+                    retest = active;  // the exit went beyond the list's reach: once more against all
+                    exit = 0;
+                    for_each_bit(retest, [&](int e) {
+                        const EllipsoidFrame& g = frames[static_cast<std::size_t>(e)];
+                        exit = std::max(exit, ray_exit(g, f.center, d) + 2 * surface_clearance(g) * g.radii_m.maxCoeff());
+                    });
+                    xp = f.center + d * exit;
+                }
                 Real depth = 0;
-                for_each_bit(list, [&](int e) {
+                for_each_bit(retest, [&](int e) {
                     ++r.tests;
                     depth = std::max(depth, penetration_depth(frames[static_cast<std::size_t>(e)], xp));
                 });
@@ -204,6 +218,7 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
     const Eigen::Index n = g.x.cols();
     const std::size_t e_count = g.frames.size();
     const std::vector<std::uint64_t>* lists = nullptr;
+    Real slack = std::numeric_limits<Real>::infinity();
 
     if (g.collision == CollisionMode::candidate_lists) {
         const Affine3 anchor = anchor_frame(g);
@@ -224,15 +239,19 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
             frame_move = std::max(frame_move, (c - then.translation()).norm() + (l - then.linear()).norm());
         }
         if (valid && frame_move > margin) valid = false;
+        Real particle_move_sq = 0;
         if (valid) {
             const Real budget_sq = (margin - frame_move) * (margin - frame_move);
             for (Eigen::Index p = 0; p < n; ++p) {
-                if ((to_anchor * (g.x.col(p) - anchor_origin) - g.list_anchor_x.col(p)).squaredNorm() > budget_sq) {
+                const Real d_sq = (to_anchor * (g.x.col(p) - anchor_origin) - g.list_anchor_x.col(p)).squaredNorm();
+                particle_move_sq = std::max(particle_move_sq, d_sq);
+                if (d_sq > budget_sq) {
                     valid = false;
                     break;
                 }
             }
         }
+        slack = valid ? margin - frame_move - std::sqrt(particle_move_sq) : margin;
         if (!valid) {
             const std::uint64_t tests = build_candidate_lists(g.x, g.frames, margin, g.candidates);
             g.list_anchor_x.resize(3, n);
@@ -259,7 +278,7 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
 
     const bool have_start = h > 0 && g.x_start.cols() == n;
     const CollisionResult r = collide_particles(g.x, g.v, g.inv_mass, g.frames, lists, g.last_collided, detected,
-                                                have_start ? &g.x_start : nullptr, h);
+                                                have_start ? &g.x_start : nullptr, h, slack);
     g.counters.frame_collision_tests += r.tests;
     g.counters.collision_tests += r.tests;
     g.counters.frame_collisions += r.collisions;

@@ -17,7 +17,8 @@
 //      from the centre through it meets the surface, x = c + (x - c) / |y|, and remove the
 //      velocity component along the surface normal relative to the surface's own motion
 //      (the ellipsoid is inelastic). Overlapping ellipsoids can push a particle into a
-//      neighbour, so the particle's list is re-tested until it is outside all of them.
+//      neighbour, so the particle's list is re-tested until it is outside all of them
+//      (every ellipsoid, when the push went beyond what the list bound still covers).
 //      Within a substep, a particle that collided takes the velocity of its whole move,
 //      (x_end - x_start) / h, before the normal component is removed: the constraints
 //      and the push-out then cannot pump energy into a particle held against the body.
@@ -25,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -65,10 +67,13 @@ using DetectedPairs = std::vector<std::uint64_t>;
 /// Steps 2-3 for particles [0, cols). `candidates` null = brute force. `last_collided`
 /// is read (tested first) and rewritten. With `x_start` (positions at the start of the
 /// substep of length h_s), a colliding particle's velocity is recomputed from its move.
+/// `list_slack_m`: how far a particle may still move before its list could miss an
+/// ellipsoid; a particle pushed farther is re-tested against every ellipsoid.
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr,
-                                  const Matrix3X* x_start = nullptr, Real h_s = 0);
+                                  const Matrix3X* x_start = nullptr, Real h_s = 0,
+                                  Real list_slack_m = std::numeric_limits<Real>::infinity());
 
 /// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
 [[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,
