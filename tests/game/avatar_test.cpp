@@ -1,0 +1,251 @@
+// The default avatar (game/avatar_generator.hpp): deterministic, the committed file is the
+// generator's output, a plausible body and walk, and it loads through the same import path
+// as any other character with fitted ellipsoids that cover it.
+#include "game/avatar_generator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <numbers>
+#include <set>
+#include <utility>
+
+#include "engine/assets/character_import.hpp"
+#include "systems/character/character_report.hpp"
+
+namespace drape {
+namespace {
+
+const std::filesystem::path committed_avatar = std::filesystem::path(DRAPE_SOURCE_DIR) / "assets" / "avatar.glb";
+
+// Generating takes a moment: share one model and one byte string between the tests.
+const AvatarModel& avatar() {
+    static const AvatarModel model = make_default_avatar();
+    return model;
+}
+const std::vector<std::uint8_t>& avatar_bytes() {
+    static const std::vector<std::uint8_t> bytes = [] {
+        auto r = default_avatar_glb();
+        EXPECT_TRUE(r) << (r ? "" : r.error().message);
+        return r ? *r : std::vector<std::uint8_t>{};
+    }();
+    return bytes;
+}
+
+std::vector<std::uint8_t> read_file(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+Eigen::Vector3d vertex(const AvatarModel& m, std::uint32_t i) { return m.positions.col(i).cast<double>(); }
+
+TEST(DefaultAvatar, GenerationIsDeterministic) {
+    const auto again = default_avatar_glb();
+    ASSERT_TRUE(again) << again.error().message;
+    ASSERT_FALSE(avatar_bytes().empty());
+    EXPECT_TRUE(*again == avatar_bytes()) << "two generations gave different bytes";
+}
+
+TEST(DefaultAvatar, CommittedFileIsTheGeneratorsOutput) {
+    ASSERT_TRUE(std::filesystem::exists(committed_avatar)) << committed_avatar << " is missing: run `drape make-avatar`";
+    const std::vector<std::uint8_t> committed = read_file(committed_avatar);
+    ASSERT_FALSE(avatar_bytes().empty());
+    EXPECT_EQ(committed.size(), avatar_bytes().size());
+    EXPECT_TRUE(committed == avatar_bytes())
+        << committed_avatar << " differs from the generator's output: run `drape make-avatar` and commit it";
+}
+
+TEST(DefaultAvatar, HasAFewThousandTrianglesAndAboutTwentyFiveBones) {
+    const AvatarModel& m = avatar();
+    EXPECT_GE(m.triangle_count(), 5000u);
+    EXPECT_LE(m.triangle_count(), 20000u);
+    EXPECT_GE(m.bones.size(), 20u);
+    EXPECT_LE(m.bones.size(), 30u);
+    for (const char* name : {"Hips", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftShoulder", "LeftArm",
+                             "LeftForeArm", "LeftHand", "RightArm", "RightHand", "LeftUpLeg", "LeftLeg",
+                             "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"})
+        EXPECT_GE(m.find_bone(name), 0) << name;
+    for (std::size_t b = 0; b < m.bones.size(); ++b) EXPECT_LT(m.bones[b].parent, static_cast<int>(b)) << m.bones[b].name;
+}
+
+TEST(DefaultAvatar, StandsAboutOneSeventyFiveTallOnTheFloor) {
+    const AvatarModel& m = avatar();
+    const Vec3 low = m.positions.rowwise().minCoeff(), high = m.positions.rowwise().maxCoeff();
+    EXPECT_NEAR(high.y() - low.y(), 1.75f, 0.02f);
+    EXPECT_NEAR(low.y(), 0.0f, 0.005f);
+    // Left-right symmetric about x = 0.
+    EXPECT_NEAR(low.x(), -high.x(), 0.005f);
+    // Scaling the options scales the body.
+    AvatarOptions small;
+    small.height_m = 1.6;
+    const AvatarModel s = make_default_avatar(small);
+    EXPECT_NEAR(s.positions.row(1).maxCoeff() - s.positions.row(1).minCoeff(), 1.6f, 0.02f);
+}
+
+TEST(DefaultAvatar, MeshIsClosedAndWoundOutwards) {
+    const AvatarModel& m = avatar();
+    // Every edge has a twin running the other way: no holes, consistent winding.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+    for (std::size_t t = 0; t < m.indices.size(); t += 3)
+        for (int e = 0; e < 3; ++e) ++edges[{m.indices[t + e], m.indices[t + (e + 1) % 3]}];
+    std::size_t open = 0;
+    for (const auto& [edge, count] : edges) open += edges.count({edge.second, edge.first}) == 0;
+    EXPECT_EQ(open, 0u);
+    // Positive enclosed volume of a human's order (60-90 litres for 1.75 m), and the
+    // vertex normals agree with the faces around them.
+    double volume = 0;
+    std::size_t agreeing = 0;
+    for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+        const auto a = vertex(m, m.indices[t]), b = vertex(m, m.indices[t + 1]), c = vertex(m, m.indices[t + 2]);
+        volume += a.dot(b.cross(c)) / 6.0;
+        const Eigen::Vector3d face = (b - a).cross(c - a);
+        agreeing += face.dot(m.normals.col(m.indices[t]).cast<double>()) > 0;
+    }
+    EXPECT_GT(volume, 0.045);
+    EXPECT_LT(volume, 0.095);
+    EXPECT_GE(double(agreeing) / double(m.triangle_count()), 0.99);
+    for (Eigen::Index v = 0; v < m.normals.cols(); ++v) ASSERT_NEAR(m.normals.col(v).norm(), 1.0f, 1e-4f) << v;
+}
+
+TEST(DefaultAvatar, WeightsAreNormalisedWithAtMostFourInfluences) {
+    const AvatarModel& m = avatar();
+    ASSERT_EQ(m.bone_weights.cols(), m.positions.cols());
+    for (Eigen::Index v = 0; v < m.bone_weights.cols(); ++v) {
+        ASSERT_NEAR(m.bone_weights.col(v).sum(), 1.0f, 1e-5f) << v;
+        ASSERT_GE(m.bone_weights.col(v).minCoeff(), 0.0f) << v;
+        ASSERT_GE(m.bone_indices.col(v).minCoeff(), 0) << v;
+        ASSERT_LT(m.bone_indices.col(v).maxCoeff(), static_cast<int>(m.bones.size())) << v;
+    }
+}
+
+// The A-pose keeps the hands clear of the hips and thighs (a dress hangs between them).
+TEST(DefaultAvatar, HandsHangClearOfTheBody) {
+    const AvatarModel& m = avatar();
+    std::vector<int> dominant(std::size_t(m.positions.cols()));
+    for (Eigen::Index v = 0; v < m.positions.cols(); ++v) {
+        Eigen::Index slot;
+        m.bone_weights.col(v).maxCoeff(&slot);
+        dominant[std::size_t(v)] = m.bone_indices(slot, v);
+    }
+    const std::set<int> hands{m.find_bone("LeftHand"), m.find_bone("RightHand")};
+    const std::set<int> hips_and_thighs{m.find_bone("Hips"), m.find_bone("LeftUpLeg"), m.find_bone("RightUpLeg")};
+    double closest = 1e9;
+    for (Eigen::Index h = 0; h < m.positions.cols(); ++h) {
+        if (!hands.contains(dominant[std::size_t(h)])) continue;
+        for (Eigen::Index b = 0; b < m.positions.cols(); ++b)
+            if (hips_and_thighs.contains(dominant[std::size_t(b)]))
+                closest = std::min(closest, double((m.positions.col(h) - m.positions.col(b)).norm()));
+    }
+    EXPECT_GT(closest, 0.08) << "hands come within " << closest << " m of the hips or thighs";
+}
+
+TEST(DefaultAvatar, WalkLastsOverASecondAndLoopsWithoutASeam) {
+    const AvatarModel& m = avatar();
+    ASSERT_FALSE(m.clips.empty());
+    const AvatarClip& walk = m.clips.front();
+    EXPECT_EQ(walk.name, "Walk");
+    EXPECT_GE(walk.duration_s(), 1.0);
+    EXPECT_GE(walk.keys_per_second, 30);
+    for (const AvatarClip& clip : m.clips) {
+        ASSERT_GE(clip.frame_count(), 2) << clip.name;
+        for (std::size_t b = 0; b < m.bones.size(); ++b) {
+            EXPECT_EQ(clip.rotations.front()[b].coeffs(), clip.rotations.back()[b].coeffs()) << clip.name << " " << m.bones[b].name;
+            EXPECT_EQ(clip.translations.front()[b], clip.translations.back()[b]) << clip.name << " " << m.bones[b].name;
+        }
+    }
+}
+
+// Angle of a bone's rotation about x, degrees, in (-180, 180].
+double pitch_deg(const Eigen::Quaterniond& q) {
+    const Eigen::Vector3d down = q * Eigen::Vector3d(0, -1, 0);
+    return std::atan2(down.z(), -down.y()) * 180.0 / std::numbers::pi;
+}
+
+TEST(DefaultAvatar, WalkSwingsLegsAndArmsInOppositionAndBobsThePelvis) {
+    const AvatarModel& m = avatar();
+    const AvatarClip& walk = m.clips.front();
+    const int hips = m.find_bone("Hips"), left_thigh = m.find_bone("LeftUpLeg"), right_thigh = m.find_bone("RightUpLeg"),
+              left_knee = m.find_bone("LeftLeg"), left_arm = m.find_bone("LeftArm");
+    double knee_min = 1e9, knee_max = -1e9, hip_min = 1e9, hip_max = -1e9, bob_min = 1e9, bob_max = -1e9;
+    double arm_leg = 0, legs = 0;
+    for (int f = 0; f + 1 < walk.frame_count(); ++f) {
+        const auto& r = walk.rotations[std::size_t(f)];
+        const double hip = pitch_deg(r[std::size_t(left_thigh)]), knee = -pitch_deg(r[std::size_t(left_knee)]);
+        hip_min = std::min(hip_min, hip), hip_max = std::max(hip_max, hip);
+        knee_min = std::min(knee_min, knee), knee_max = std::max(knee_max, knee);
+        const double y = walk.translations[std::size_t(f)][std::size_t(hips)].y();
+        bob_min = std::min(bob_min, y), bob_max = std::max(bob_max, y);
+        arm_leg += pitch_deg(r[std::size_t(left_arm)]) * hip;
+        legs += hip * pitch_deg(r[std::size_t(right_thigh)]);
+    }
+    EXPECT_GT(hip_max - hip_min, 25.0);   // Hip flexion/extension.
+    EXPECT_GT(knee_max - knee_min, 40.0); // Knee flexes in swing.
+    EXPECT_LT(arm_leg, 0.0) << "the left arm swings with the left leg, not against it";
+    EXPECT_LT(legs, 0.0) << "the legs swing together, not in turn";
+    EXPECT_GT(bob_max - bob_min, 0.01);   // Vertical bob of the pelvis.
+    EXPECT_LT(bob_max - bob_min, 0.08);
+}
+
+TEST(DefaultAvatar, OptionsOutOfRangeAreRefusedByName) {
+    AvatarOptions bad;
+    bad.grid_spacing_m = 0;
+    const auto r = default_avatar_glb(bad);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("grid_spacing_m"), std::string::npos) << r.error().message;
+    bad = {};
+    bad.height_m = std::nan("");
+    const auto w = write_default_avatar(std::filesystem::temp_directory_path() / "drape_never_written.glb", bad);
+    ASSERT_FALSE(w);
+    EXPECT_NE(w.error().message.find("height_m"), std::string::npos) << w.error().message;
+}
+
+TEST(DefaultAvatar, UnwritablePathIsAnErrorNamingIt) {
+    const auto path = std::filesystem::path("/nonexistent-drape-dir/avatar.glb");
+    const auto r = write_avatar(avatar(), path);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find(path.string()), std::string::npos) << r.error().message;
+}
+
+// The committed file through the importer every character goes through.
+TEST(DefaultAvatar, ImportsLikeAnyCharacter) {
+    const auto imported = import_character(committed_avatar);
+    ASSERT_TRUE(imported) << imported.error().message;
+    const CharacterAsset& c = **imported;
+    const AvatarModel& m = avatar();
+    EXPECT_GE(c.height_m, 1.6f);
+    EXPECT_LE(c.height_m, 1.9f);
+    EXPECT_GE(c.skeleton->size(), 20u);
+    EXPECT_LE(c.skeleton->size(), 30u);
+    EXPECT_EQ(c.mesh->vertex_count(), std::size_t(m.positions.cols()));
+    EXPECT_EQ(c.mesh->indices.size(), m.indices.size());
+    EXPECT_EQ(c.skin_bones, 22);
+    ASSERT_EQ(c.clips.size(), m.clips.size());
+    const auto walk = find_clip(c, "Walk");
+    ASSERT_TRUE(walk) << walk.error().message;
+    const AnimationClip& clip = *c.clips[*walk];
+    EXPECT_NEAR(clip.duration_s, m.clips.front().duration_s(), 1e-4);
+    EXPECT_FALSE(clip.channels.empty());
+    for (const BoneChannel& channel : clip.channels) {
+        ASSERT_GE(channel.rotations.size(), 2u);
+        EXPECT_TRUE(channel.rotations.front().coeffs().isApprox(channel.rotations.back().coeffs(), 1e-6f))
+            << c.skeleton->bone_names[std::size_t(channel.bone)];
+    }
+    EXPECT_EQ(c.hip_bone, c.skeleton->find("Hips"));
+}
+
+TEST(DefaultAvatar, FittedEllipsoidsCoverTheBody) {
+    const auto imported = import_character(committed_avatar);
+    ASSERT_TRUE(imported) << imported.error().message;
+    const CharacterAsset& c = **imported;
+    EXPECT_GE(c.ellipsoids.size(), 12u);
+    EXPECT_LE(c.ellipsoids.size(), 22u);
+    const CoverageReport coverage = rest_pose_coverage(c);
+    EXPECT_GE(coverage.coverage, 0.95) << "max gap " << coverage.max_gap_m << " m";
+}
+
+}  // namespace
+}  // namespace drape
