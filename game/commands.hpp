@@ -12,6 +12,9 @@ void add_play_command(CLI::App& app);
 /// `drape inspect FILE`: what a character file holds.
 void add_inspect_command(CLI::App& app);
 
+/// `drape make-avatar [--out FILE]`: writes the default avatar (assets/avatar.glb).
+void add_make_avatar_command(CLI::App& app);
+
 /// `drape bench NAME`: benchmarks and reports (bench/).
 void add_bench_command(CLI::App& app);
 

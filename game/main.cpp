@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(0, 1);
     drape::add_play_command(app);
     drape::add_inspect_command(app);
+    drape::add_make_avatar_command(app);
 #ifdef DRAPE_HAVE_BENCH
     drape::add_bench_command(app);
 #endif
