@@ -1,0 +1,293 @@
+// Builders, pins, substeps, counters, reset and determinism (method §3.2, §3.4, §3.5).
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include <tbb/global_control.h>
+
+#include "analytic_body.hpp"
+#include "components/skeleton.hpp"
+#include "components/skinned_mesh.hpp"
+#include "components/transform.hpp"
+#include "systems/cloth/body.hpp"
+#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth/collision.hpp"
+#include "systems/cloth/garment_builder.hpp"
+#include "systems/cloth/garment_step.hpp"
+#include "systems/cloth/pins.hpp"
+
+namespace drape {
+namespace {
+
+TEST(Builders, DefaultSkirtHas837ParticlesIn27WarpLinesOf31) {
+    Registry registry;
+    test::AnalyticBody body(registry);
+    const auto e = attach_skirt(registry, body.character, SkirtParams{});
+    ASSERT_TRUE(e) << e.error().message;
+    const Garment& g = registry.get<Garment>(*e);
+    EXPECT_EQ(g.x.cols(), 837);
+    EXPECT_EQ(g.topology->warp_lines, 27u);
+    EXPECT_EQ(g.topology->particles_per_line, 31u);
+    EXPECT_EQ(g.topology->layer1_count, 9u * 31u);
+    EXPECT_EQ(g.colliders.size(), 15u);
+    EXPECT_EQ(g.pins.size(), 27u);
+    EXPECT_EQ(g.topology->triangles.size(), 27u * 30u * 6u);
+    // Placed around the hips: the waist ring is near the pelvis, the hem lower.
+    const auto& pelvis = registry.get<EllipsoidCollider>(body.colliders[0]);
+    for (const PinBinding& pin : g.pins) {
+        EXPECT_EQ(pin.kind, PinKind::collider);
+        EXPECT_LT(std::abs(g.x(1, pin.particle) - pelvis.world.translation().y()), 0.2f);
+    }
+    for (Eigen::Index p = 0; p < g.x.cols(); ++p)
+        for (Entity c : g.colliders)
+            EXPECT_LE(penetration_depth(make_ellipsoid_frame(registry.get<EllipsoidCollider>(c).world), g.x.col(p)), 1e-5);
+}
+
+TEST(Builders, DressScalesPastTenThousandParticles) {
+    Registry registry;
+    test::AnalyticBody body(registry);
+    const auto e = attach_dress(registry, body.character, DressParams{});
+    ASSERT_TRUE(e) << e.error().message;
+    const Garment& g = registry.get<Garment>(*e);
+    EXPECT_GE(g.x.cols(), 10000);
+    // Hangs from the shoulders: the pinned ring is above the chest centre's bottom.
+    const Real chest_y = registry.get<EllipsoidCollider>(body.colliders[2]).world.translation().y();
+    for (const PinBinding& pin : g.pins) EXPECT_GT(g.x(1, pin.particle), chest_y - 0.2f);
+}
+
+TEST(Builders, ParameterErrorsNameTheField) {
+    Registry registry;
+    test::AnalyticBody body(registry);
+    auto message = [&](SkirtParams p) {
+        auto e = attach_skirt(registry, body.character, p);
+        return e ? std::string() : e.error().message;
+    };
+    SkirtParams p;
+    p.length_m = -1;
+    EXPECT_EQ(message(p).rfind("skirt.length_m: must be > 0", 0), 0u) << message(p);
+    p = {};
+    p.warp_lines = 28;
+    EXPECT_EQ(message(p).rfind("skirt.warp_lines: must be a multiple of skirt.weft_stride", 0), 0u) << message(p);
+    p = {};
+    p.material.mass_kg = std::numeric_limits<Real>::quiet_NaN();
+    EXPECT_EQ(message(p).rfind("skirt.material.mass_kg: must be > 0", 0), 0u) << message(p);
+    p = {};
+    p.fitting_rows = 0;
+    EXPECT_EQ(message(p).rfind("skirt.fitting_rows:", 0), 0u) << message(p);
+    DressParams d;
+    d.flare_deg = 95;
+    auto de = attach_dress(registry, body.character, d);
+    ASSERT_FALSE(de);
+    EXPECT_EQ(de.error().message.rfind("dress.flare_deg:", 0), 0u) << de.error().message;
+    RectangleParams r;
+    r.warp_lines = 17;  // 16 % 3 != 0
+    auto re = make_rectangle(r);
+    ASSERT_FALSE(re);
+    EXPECT_EQ(re.error().message.rfind("rectangle.warp_lines:", 0), 0u) << re.error().message;
+    // A character without colliders, and a dead one.
+    const Entity bare = registry.create();
+    auto none = attach_skirt(registry, bare, SkirtParams{});
+    ASSERT_FALSE(none);
+    EXPECT_NE(none.error().message.find("no ellipsoid colliders"), std::string::npos);
+    registry.destroy(bare);
+    EXPECT_FALSE(attach_skirt(registry, bare, SkirtParams{}));
+}
+
+TEST(Pins, FollowTheirBindingExactlyAtTheEndOfEveryStep) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, SkirtParams{});
+    for (int frame = 0; frame < 90; ++frame) {
+        scene.run(1);
+        const Garment& g = scene.registry.get<Garment>(e);
+        for (const PinBinding& pin : g.pins) {
+            const auto expected = evaluate_pin(scene.registry, g, pin);
+            ASSERT_TRUE(expected);
+            ASSERT_LE((g.x.col(pin.particle) - *expected).norm(), 1e-6) << "pin " << pin.particle;
+        }
+    }
+}
+
+// A two-bone character with a skin: skirt pins are skinned with the weights of the
+// nearest skin vertex and stay on it as the bones move.
+TEST(Pins, SkinnedPinsFollowLinearBlendSkinningOfTheSkin) {
+    Registry registry;
+    const Entity character = registry.create();
+    auto skeleton_asset = std::make_shared<SkeletonAsset>();
+    skeleton_asset->bone_names = {"hips", "spine"};
+    skeleton_asset->parents = {-1, 0};
+    skeleton_asset->rest_local = {Affine3::Identity(), Affine3::Identity()};
+    skeleton_asset->inverse_bind = {Affine3::Identity(), Affine3::Identity()};
+    Skeleton skeleton;
+    skeleton.asset = skeleton_asset;
+    skeleton.local = skeleton.global = skeleton.skinning = {Affine3::Identity(), Affine3::Identity()};
+    registry.emplace<Skeleton>(character, skeleton);
+    Transform transform;
+    transform.position = Vec3(1, 0, -2);
+    registry.emplace<Transform>(character, transform);
+    // Skin: a ring of vertices around the hips, half bound to each bone.
+    auto mesh = std::make_shared<MeshAsset>();
+    const int ring = 64;
+    mesh->bind_positions.resize(3, ring);
+    mesh->bind_normals = Matrix3X::Zero(3, ring);
+    mesh->bone_indices.resize(4, ring);
+    mesh->bone_weights.resize(4, ring);
+    for (int i = 0; i < ring; ++i) {
+        const Real a = Real(2 * std::numbers::pi * i / ring);
+        mesh->bind_positions.col(i) = Vec3(0.19f * std::sin(a), 1.0f, 0.14f * std::cos(a));
+        mesh->bone_indices.col(i) << 0, 1, 0, 0;
+        const Real w = Real(0.5) + Real(0.5) * std::sin(a);
+        mesh->bone_weights.col(i) << w, 1 - w, 0, 0;
+    }
+    registry.emplace<SkinnedMesh>(character, SkinnedMesh{mesh, {}, {}});
+    // Colliders: a pelvis and a torso on the bones, placed in world space.
+    for (int bone = 0; bone < 2; ++bone) {
+        EllipsoidCollider c;
+        c.character = character;
+        c.bone = bone;
+        Affine3 w = transform.matrix();
+        w.translate(Vec3(0, bone == 0 ? 1.0f : 1.3f, 0));
+        w.scale(Vec3(0.18f, 0.15f, 0.13f));
+        c.world = c.previous_world = w;
+        c.initialised = true;
+        registry.emplace<EllipsoidCollider>(registry.create(), c);
+    }
+    SkirtParams params;
+    params.waist_height_m = 0.15f;  // above the lowest collider point
+    const auto e = attach_skirt(registry, character, params);
+    ASSERT_TRUE(e) << e.error().message;
+    Garment& g = registry.get<Garment>(*e);
+    for (const PinBinding& pin : g.pins) ASSERT_EQ(pin.kind, PinKind::skinned);
+
+    // Move the bones and the character; every pin must be where LBS puts it.
+    auto& s = registry.get<Skeleton>(character);
+    s.skinning[0] = Affine3(Eigen::AngleAxis<Real>(0.3f, Vec3::UnitY())) * Affine3(Eigen::Translation<Real, 3>(0, 0.05f, 0));
+    s.skinning[1] = Affine3(Eigen::AngleAxis<Real>(-0.2f, Vec3::UnitX()));
+    registry.get<Transform>(character).position = Vec3(1.5f, 0, -1.5f);
+    Scheduler scheduler;
+    add_cloth_systems(scheduler);
+    ASSERT_TRUE(scheduler.tick(registry, 1.0 / 60.0));
+    const Affine3 world = registry.get<Transform>(character).matrix();
+    for (const PinBinding& pin : g.pins) {
+        const Vec3 expected = world * (blend_skinning(s.skinning, pin.bones, pin.weights) * pin.local);
+        ASSERT_LE((g.x.col(pin.particle) - expected).norm(), 1e-6);
+        // The binding uses the weights of a skin vertex.
+        bool matches = false;
+        for (int i = 0; i < ring; ++i)
+            matches = matches || (mesh->bone_weights.col(i) - pin.weights).norm() < 1e-6;
+        EXPECT_TRUE(matches);
+    }
+}
+
+TEST(Substeps, RuleFollowsStabilityAndColliderSpeed) {
+    Registry registry;
+    test::WalkSettings still;
+    still.hip_swing_rad = still.knee_bend_rad = still.forward_speed_m_s = still.yaw_rad = 0;
+    test::AnalyticBody body(registry, still);
+    const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
+    Garment& g = registry.get<Garment>(e);
+    const ClothSolverSettings settings;
+    EXPECT_EQ(garment_substeps(registry, g, 1.0 / 60.0, settings), 1);  // default skirt: one substep
+    g.model = ClothModel::classic;
+    EXPECT_GE(garment_substeps(registry, g, 1.0 / 60.0, settings), 2);  // same material, more springs
+    g.model = ClothModel::simplified;
+    g.material.stretch_k_N_m *= 16;                                      // 4x the stability need
+    EXPECT_EQ(garment_substeps(registry, g, 1.0 / 60.0, settings), 4);
+    g.material.stretch_k_N_m /= 16;
+    // A thigh swinging at 6 m/s relative to the pelvis: 0.1 m per step / 0.04 m -> 3 substeps.
+    registry.get<EllipsoidCollider>(body.colliders[7]).velocity_m_s = Vec3(0, 0, 6);
+    g.lists_valid = false;
+    EXPECT_EQ(garment_substeps(registry, g, 1.0 / 60.0, settings), 3);
+    EXPECT_EQ(g.counters.substeps_motion, 3);
+    // Capped.
+    registry.get<EllipsoidCollider>(body.colliders[7]).velocity_m_s = Vec3(0, 0, 600);
+    EXPECT_EQ(cloth_substeps(registry, 1.0 / 60.0, settings), settings.max_substeps);
+}
+
+TEST(Systems, ThreeClothSystemsRunInOrderInTheSimulationPhase) {
+    Scheduler scheduler;
+    add_cloth_systems(scheduler);
+    EXPECT_EQ(scheduler.system_names(Phase::simulation),
+              (std::vector<std::string>{"cloth_integration", "cloth_constraint", "cloth_collision"}));
+}
+
+TEST(Robustness, NonFiniteValuesAreDetectedReportedAndTheGarmentReset) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, SkirtParams{});
+    scene.run(20);
+    Garment& g = scene.registry.get<Garment>(e);
+    g.x(1, 500) = std::numeric_limits<Real>::quiet_NaN();
+    g.v(0, 400) = std::numeric_limits<Real>::infinity();
+    testing::internal::CaptureStderr();
+    scene.run(1);
+    const std::string report = testing::internal::GetCapturedStderr();
+    EXPECT_NE(report.find("non-finite"), std::string::npos);
+    EXPECT_GE(g.counters.non_finite_values, 1u);
+    EXPECT_EQ(g.counters.resets, 1u);
+    EXPECT_TRUE(g.x.allFinite());
+    EXPECT_TRUE(g.v.allFinite());
+    scene.run(30);
+    EXPECT_TRUE(g.x.allFinite());
+    EXPECT_EQ(g.counters.resets, 1u);
+}
+
+TEST(Robustness, ResetPutsTheGarmentBackAtRestAroundTheBodyWhereItIsNow) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, SkirtParams{});
+    const Garment& g = scene.registry.get<Garment>(e);
+    scene.run(60);  // walked 1.2 m
+    reset_garment(scene.registry, e);
+    const auto& pelvis = scene.registry.get<EllipsoidCollider>(scene.body.colliders[0]);
+    const Vec3 centre = pelvis.world.translation();
+    for (Eigen::Index p = 0; p < g.x.cols(); ++p) {
+        const Vec3 d = g.x.col(p) - centre;
+        ASSERT_LT(Vec3(d.x(), 0, d.z()).norm(), 0.6f);
+        ASSERT_LT(std::abs(d.y()), 0.8f);
+    }
+    for (const PinBinding& pin : g.pins)
+        EXPECT_LE((g.x.col(pin.particle) - *evaluate_pin(scene.registry, g, pin)).norm(), 1e-6);
+    EXPECT_EQ(g.counters.resets, 1u);
+}
+
+// Several avatars at different phases, simulated with one or two threads.
+Matrix3X simulate_crowd(int threads, int avatars, int frames) {
+    tbb::global_control control(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    Registry registry;
+    Scheduler scheduler;
+    std::vector<std::unique_ptr<test::AnalyticBody>> bodies;
+    std::vector<Entity> garments;
+    for (int i = 0; i < avatars; ++i) {
+        test::WalkSettings walk;
+        walk.phase_s = 0.13 * i;
+        walk.origin = Vec3(Real(1.5) * Real(i), 0, 0);
+        bodies.push_back(std::make_unique<test::AnalyticBody>(registry, walk));
+        scheduler.add(bodies.back()->system(registry));
+        SkirtParams params;
+        params.model = i % 2 ? ClothModel::classic : ClothModel::simplified;
+        garments.push_back(*attach_skirt(registry, bodies.back()->character, params));
+    }
+    add_cloth_systems(scheduler);
+    for (int f = 0; f < frames; ++f) (void)scheduler.tick(registry, 1.0 / 60.0);
+    Matrix3X all(3, 0);
+    for (Entity e : garments) {
+        const Matrix3X& x = registry.get<Garment>(e).x;
+        Matrix3X joined(3, all.cols() + x.cols());
+        joined << all, x;
+        all = joined;
+    }
+    return all;
+}
+
+bool same_bytes(const Matrix3X& a, const Matrix3X& b) {
+    return a.cols() == b.cols() && std::memcmp(a.data(), b.data(), sizeof(Real) * std::size_t(a.size())) == 0;
+}
+
+TEST(Determinism, TwoIdenticalRunsGiveIdenticalBytes) {
+    EXPECT_TRUE(same_bytes(simulate_crowd(2, 3, 90), simulate_crowd(2, 3, 90)));
+}
+
+TEST(Determinism, OneOrTwoThreadsGiveIdenticalBytes) {
+    EXPECT_TRUE(same_bytes(simulate_crowd(1, 4, 60), simulate_crowd(2, 4, 60)));
+}
+
+}  // namespace
+}  // namespace drape
