@@ -166,10 +166,11 @@ std::vector<Shape> make_body_shapes(const std::vector<AvatarBone>& bones, double
     ellipsoid(Head, 0.012, {0.0, 1.635, 0.095}, {0.014, 0.024, 0.022});
     for (double side : {1.0, -1.0}) {
         const bool left = side > 0;
-        // Arm: upper arm with the deltoid's bulge, forearm, a flat hand with the palm inwards.
+        // Arm: the deltoid's cap, upper arm, forearm, a flat hand with the palm inwards.
         const int arm = left ? LeftArm : RightArm, fore = left ? LeftForeArm : RightForeArm,
                   hand = left ? LeftHand : RightHand;
-        capsule(arm, 0.035, joint(arm), 0.05, joint(fore), 0.04);
+        ellipsoid(arm, 0.05, (joint(arm) + s * Vector3d(side * 0.012, -0.045, 0.0)) / s, {0.05, 0.08, 0.052});
+        capsule(arm, 0.03, joint(arm) + 0.03 * s * arm_direction(side), 0.046, joint(fore), 0.04);
         capsule(fore, 0.015, joint(fore), 0.041, joint(hand), 0.027);
         Matrix3d hand_axes;
         const Vector3d along = arm_direction(side);

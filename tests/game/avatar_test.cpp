@@ -16,6 +16,7 @@
 
 #include "engine/assets/character_import.hpp"
 #include "systems/character/character_report.hpp"
+#include "systems/character/pose.hpp"
 
 namespace drape {
 namespace {
@@ -245,6 +246,43 @@ TEST(DefaultAvatar, FittedEllipsoidsCoverTheBody) {
     EXPECT_LE(c.ellipsoids.size(), 22u);
     const CoverageReport coverage = rest_pose_coverage(c);
     EXPECT_GE(coverage.coverage, 0.95) << "max gap " << coverage.max_gap_m << " m";
+}
+
+// Played through the engine's own sampling and skinning: the soles meet the floor all
+// through the walk (no floating, no sinking), and the swinging hands keep clear of the
+// hips and thighs, where a skirt hangs.
+TEST(DefaultAvatar, WalkKeepsTheFeetOnTheFloorAndTheHandsOffTheHips) {
+    const auto imported = import_character(committed_avatar);
+    ASSERT_TRUE(imported) << imported.error().message;
+    const CharacterAsset& c = **imported;
+    const auto walk = find_clip(c, "Walk");
+    ASSERT_TRUE(walk) << walk.error().message;
+    const AnimationClip& clip = *c.clips[*walk];
+    const std::vector<int> dominant = dominant_bones(*c.mesh);
+    const SkeletonAsset& s = *c.skeleton;
+    const std::set<int> hands{s.find("LeftHand"), s.find("RightHand")};
+    const std::set<int> hips_and_thighs{s.find("Hips"), s.find("LeftUpLeg"), s.find("RightUpLeg")};
+    std::vector<Affine3> local, global, skinning;
+    Matrix3X p;
+    double lowest_min = 1e9, lowest_max = -1e9, closest = 1e9;
+    constexpr int samples = 24;
+    for (int i = 0; i < samples; ++i) {
+        sample_clip(clip, s, clip.duration_s * i / samples, true, local);
+        compose_pose(s, local, global);
+        skinning_matrices(s, global, skinning);
+        skin_positions(*c.mesh, skinning, Affine3::Identity(), p);
+        const double lowest = p.row(1).minCoeff();
+        lowest_min = std::min(lowest_min, lowest), lowest_max = std::max(lowest_max, lowest);
+        for (Eigen::Index h = 0; h < p.cols(); ++h) {
+            if (!hands.contains(dominant[std::size_t(h)])) continue;
+            for (Eigen::Index b = 0; b < p.cols(); ++b)
+                if (hips_and_thighs.contains(dominant[std::size_t(b)]))
+                    closest = std::min(closest, double((p.col(h) - p.col(b)).norm()));
+        }
+    }
+    EXPECT_GT(lowest_min, -0.015) << "a foot sinks into the floor";
+    EXPECT_LT(lowest_max, 0.015) << "both feet leave the floor";
+    EXPECT_GT(closest, 0.05) << "a hand comes within " << closest << " m of the hips or thighs";
 }
 
 }  // namespace
