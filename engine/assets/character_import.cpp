@@ -572,9 +572,10 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     auto shared_skeleton = std::make_shared<const SkeletonAsset>(std::move(skeleton));
     asset->skeleton = shared_skeleton;
     asset->hip_bone = find_hip_bone(*shared_skeleton);
-    if (options.fit_ellipsoids) asset->ellipsoids = fit_ellipsoids(*shared_skeleton, *mesh, asset->height_m, options.fit);
-    asset->mesh = std::move(mesh);
     for (auto& clip : clips) asset->clips.push_back(std::move(clip));
+    if (options.fit_ellipsoids)
+        asset->ellipsoids = fit_ellipsoids(*shared_skeleton, *mesh, asset->height_m, options.fit, asset->clips);
+    asset->mesh = std::move(mesh);
     return std::shared_ptr<const CharacterAsset>(std::move(asset));
 }
 

@@ -67,6 +67,74 @@ Matrix3X sphere_samples(int n) {
     return out;
 }
 
+// One ellipsoid around a cluster, in the bone frame `frame` (rigid, model space at bind):
+// principal axes, centred on the bounding box in that frame, scaled uniformly until
+// `cluster_coverage` of the points are inside.
+EllipsoidShape fit_cluster(const MeshAsset& mesh, const Affine3& frame, const std::vector<Eigen::Index>& c,
+                           const FitOptions& options) {
+    const Affine3 to_bone = frame.inverse();
+    Matrix3X q(3, static_cast<Eigen::Index>(c.size()));
+    for (std::size_t i = 0; i < c.size(); ++i) q.col(static_cast<Eigen::Index>(i)) = to_bone * mesh.bind_positions.col(c[i]);
+    const Vec3 mean = q.rowwise().mean();
+    Mat3 covariance = Mat3::Zero();
+    for (Eigen::Index i = 0; i < q.cols(); ++i) {
+        const Vec3 d = q.col(i) - mean;
+        covariance.noalias() += d * d.transpose();
+    }
+    covariance /= Real(c.size());
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(covariance);
+    Mat3 axes = eig.eigenvectors();
+    if (!axes.allFinite()) axes.setIdentity();
+    if (axes.determinant() < 0) axes.col(0) *= -1;
+    const Matrix3X y = axes.transpose().lazyProduct(q);  // cluster in the principal frame
+    const Vec3 lo = y.rowwise().minCoeff(), hi = y.rowwise().maxCoeff();
+    const Vec3 centre_y = (lo + hi) / 2;
+    const Vec3 half = ((hi - lo) / 2).cwiseMax(static_cast<Real>(options.min_radius_m));
+    std::vector<Real> d(c.size());
+    for (std::size_t i = 0; i < c.size(); ++i) d[i] = ((y.col(static_cast<Eigen::Index>(i)) - centre_y).cwiseQuotient(half)).norm();
+    const auto k = std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(options.cluster_coverage * double(d.size()))) - 1);
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+    const Real s = std::max(d[k], Real(1e-3));
+    EllipsoidShape shape;
+    shape.center = axes * centre_y;
+    shape.rotation = Quat(axes).normalized();
+    shape.radii_m = (half * s).cwiseMax(static_cast<Real>(options.min_radius_m));
+    return shape;
+}
+
+double volume(const EllipsoidShape& s) { return 4.0 / 3.0 * std::numbers::pi * double(s.radii_m.prod()); }
+
+// "LeftArm" <-> "RightArm", "UpperArm.L" <-> "UpperArm.R", "thigh_l" <-> "thigh_r",
+// "FootL" <-> "FootR"; empty when the name has no side.
+std::string mirror_name(const std::string& name) {
+    static const std::pair<std::string_view, std::string_view> swaps[] = {
+        {"Left", "Right"}, {"left", "right"}, {".L", ".R"}, {".l", ".r"}, {"_L", "_R"}, {"_l", "_r"}};
+    for (auto [a, b] : swaps)
+        for (int flip = 0; flip < 2; ++flip) {
+            const std::string_view from = flip ? b : a, to = flip ? a : b;
+            if (const auto at = name.find(from); at != std::string::npos)
+                return name.substr(0, at) + std::string(to) + name.substr(at + from.size());
+        }
+    if (!name.empty() && (name.back() == 'L' || name.back() == 'R'))
+        return name.substr(0, name.size() - 1) + (name.back() == 'L' ? 'R' : 'L');
+    return {};
+}
+
+// Per bone, the largest angle its local rotation turns away from the rest pose in any clip.
+std::vector<double> joint_motion(const SkeletonAsset& skeleton, std::span<const std::shared_ptr<const AnimationClip>> clips) {
+    std::vector<double> out(skeleton.size(), 0);
+    for (const auto& clip : clips) {
+        if (!clip) continue;
+        for (const BoneChannel& ch : clip->channels) {
+            if (ch.bone < 0 || static_cast<std::size_t>(ch.bone) >= skeleton.size()) continue;
+            const Quat rest = skeleton.rest_rotation.empty() ? Quat::Identity() : skeleton.rest_rotation[static_cast<std::size_t>(ch.bone)];
+            for (const Quat& q : ch.rotations)
+                out[static_cast<std::size_t>(ch.bone)] = std::max(out[static_cast<std::size_t>(ch.bone)], double(rest.angularDistance(q)));
+        }
+    }
+    return out;
+}
+
 }  // namespace
 
 Result<void> validate(const FitOptions& o) {
@@ -74,6 +142,7 @@ Result<void> validate(const FitOptions& o) {
     if (!(o.min_cluster_size >= 0 && o.min_cluster_size < 1)) return fail("fit.min_cluster_size: must be in [0, 1)");
     if (!(o.cluster_coverage > 0 && o.cluster_coverage <= 1)) return fail("fit.cluster_coverage: must be in (0, 1]");
     if (!(o.min_radius_m > 0 && std::isfinite(o.min_radius_m))) return fail("fit.min_radius_m: must be > 0");
+    if (o.max_ellipsoids < 0) return fail("fit.max_ellipsoids: must be >= 0 (0: no limit)");
     return {};
 }
 
@@ -124,7 +193,8 @@ std::vector<int> dominant_bones(const MeshAsset& mesh) {
 }
 
 std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
-                                           const FitOptions& options) {
+                                           const FitOptions& options,
+                                           std::span<const std::shared_ptr<const AnimationClip>> clips) {
     const std::size_t bones = skeleton.size();
     const std::size_t n = mesh.vertex_count();
     std::vector<std::vector<Eigen::Index>> clusters(bones);
@@ -189,40 +259,57 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
                 move(s, b);
     }
 
+    // Too many clusters for the budget: merge, one at a time, the child cluster whose joint
+    // moves least in the clips (a stiff back, a clavicle before an elbow), ties broken by
+    // the ellipsoid volume the union adds; a left/right partner merges along with it so
+    // the body stays symmetric.
+    auto nearest_ancestor = [&](std::size_t b) -> int {
+        for (int p = skeleton.parents[b]; p >= 0; p = skeleton.parents[static_cast<std::size_t>(p)])
+            if (clusters[static_cast<std::size_t>(p)].size() >= 4) return p;
+        return -1;
+    };
+    auto fitted = [&](std::size_t b) { return clusters[b].size() >= 4; };
+    const std::vector<double> motion = joint_motion(skeleton, clips);
+    std::size_t active = 0;
+    for (std::size_t b = 0; b < bones; ++b) active += fitted(b) ? 1 : 0;
+    const double unit_volume = std::max(1e-9, double(height_m) * height_m * height_m);
+    while (options.max_ellipsoids > 0 && active > static_cast<std::size_t>(options.max_ellipsoids)) {
+        double best_cost = std::numeric_limits<double>::max();
+        std::size_t best_child = bones, best_parent = bones;
+        for (std::size_t b = 0; b < bones; ++b) {
+            if (!fitted(b)) continue;
+            const int a = nearest_ancestor(b);
+            if (a < 0) continue;
+            const auto pa = static_cast<std::size_t>(a);
+            std::vector<Eigen::Index> both = clusters[pa];
+            both.insert(both.end(), clusters[b].begin(), clusters[b].end());
+            const double added = volume(fit_cluster(mesh, frame[pa], both, options)) -
+                                 volume(fit_cluster(mesh, frame[pa], clusters[pa], options)) -
+                                 volume(fit_cluster(mesh, frame[b], clusters[b], options));
+            // Motion between b and its ancestor: every joint on the way moves the cluster.
+            double moves = 0;
+            for (std::size_t j = b; j != pa; j = static_cast<std::size_t>(skeleton.parents[j])) moves = std::max(moves, motion[j]);
+            const double cost = moves + 10 * std::max(0.0, added) / unit_volume;
+            if (cost < best_cost) { best_cost = cost; best_child = b; best_parent = pa; }
+        }
+        if (best_child == bones) break;
+        const int partner = skeleton.find(mirror_name(skeleton.bone_names[best_child]));
+        move(best_child, best_parent);
+        --active;
+        if (partner >= 0 && static_cast<std::size_t>(partner) != best_child && fitted(static_cast<std::size_t>(partner))) {
+            const int a = nearest_ancestor(static_cast<std::size_t>(partner));
+            if (a >= 0) {
+                move(static_cast<std::size_t>(partner), static_cast<std::size_t>(a));
+                --active;
+            }
+        }
+    }
+
     std::vector<EllipsoidShape> shapes;
     for (std::size_t b = 0; b < bones; ++b) {
-        const auto& c = clusters[b];
-        if (c.size() < 4) continue;
-        const Affine3 to_bone = frame[b].inverse();
-        Matrix3X q(3, static_cast<Eigen::Index>(c.size()));
-        for (std::size_t i = 0; i < c.size(); ++i) q.col(static_cast<Eigen::Index>(i)) = to_bone * mesh.bind_positions.col(c[i]);
-        const Vec3 mean = q.rowwise().mean();
-        Mat3 covariance = Mat3::Zero();
-        for (Eigen::Index i = 0; i < q.cols(); ++i) {
-            const Vec3 d = q.col(i) - mean;
-            covariance.noalias() += d * d.transpose();
-        }
-        covariance /= Real(c.size());
-        Eigen::SelfAdjointEigenSolver<Mat3> eig(covariance);
-        Mat3 axes = eig.eigenvectors();
-        if (!axes.allFinite()) axes.setIdentity();
-        if (axes.determinant() < 0) axes.col(0) *= -1;
-        const Matrix3X y = axes.transpose().lazyProduct(q);  // cluster in the principal frame
-        const Vec3 lo = y.rowwise().minCoeff(), hi = y.rowwise().maxCoeff();
-        const Vec3 centre_y = (lo + hi) / 2;
-        const Vec3 half = ((hi - lo) / 2).cwiseMax(static_cast<Real>(options.min_radius_m));
-        std::vector<Real> d(c.size());
-        for (std::size_t i = 0; i < c.size(); ++i)
-            d[i] = ((y.col(static_cast<Eigen::Index>(i)) - centre_y).cwiseQuotient(half)).norm();
-        const auto k = std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(options.cluster_coverage * double(d.size()))) - 1);
-        std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
-        const Real s = std::max(d[k], Real(1e-3));
-
-        EllipsoidShape shape;
+        if (!fitted(b)) continue;
+        EllipsoidShape shape = fit_cluster(mesh, frame[b], clusters[b], options);
         shape.bone = static_cast<int>(b);
-        shape.center = axes * centre_y;
-        shape.rotation = Quat(axes).normalized();
-        shape.radii_m = (half * s).cwiseMax(static_cast<Real>(options.min_radius_m));
         shape.region = holds_hip[b] ? BodyRegion::pelvis : region_from_bone_name(skeleton.bone_names[b]);
         shapes.push_back(shape);
     }

@@ -6,17 +6,21 @@
 // their parent (fingers merge into the hand, a toe into the foot); each remaining cluster
 // gets an ellipsoid whose axes are the cluster's principal axes, centred on its bounding
 // box in that frame, scaled so that `cluster_coverage` of the cluster's vertices lie inside.
+// Hands and feet get one ellipsoid each. Above `max_ellipsoids`, the child cluster whose
+// joint moves least in the clips merges into its parent first (with its left/right partner).
 //
 // Coverage (the acceptance measure): the share of body vertices inside some ellipsoid or
 // within `tolerance_m` of one. Bulge: how far ellipsoid surfaces stand out of the body,
 // measured at sample points on each surface against the nearest body vertex and its normal.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "components/animation_player.hpp"
 #include "components/ellipsoid_collider.hpp"
 #include "components/skeleton.hpp"
 #include "components/skinned_mesh.hpp"
@@ -30,6 +34,7 @@ struct FitOptions {
     double min_cluster_size = 0.09;        ///< ... or whose cluster is shorter than this share of the height.
     double cluster_coverage = 0.97;        ///< Share of a cluster's vertices an ellipsoid must hold.
     double min_radius_m = 0.01;            ///< No axis thinner than this.
+    int max_ellipsoids = 16;               ///< Budget (the paper's avatar has 15); 0 = one per surviving cluster.
 };
 
 /// Checks the options; the error names the field.
@@ -45,9 +50,11 @@ struct FitOptions {
 /// Bone of each vertex: the index with the largest weight.
 [[nodiscard]] std::vector<int> dominant_bones(const MeshAsset& mesh);
 
-/// Fits ellipsoids to the mesh at bind. `height_m` sets the scale of "small" clusters.
+/// Fits ellipsoids to the mesh at bind. `height_m` sets the scale of "small" clusters;
+/// `clips` tell which joints move (stiff ones merge first when over budget).
 [[nodiscard]] std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh,
-                                                         Real height_m, const FitOptions& options = {});
+                                                         Real height_m, const FitOptions& options = {},
+                                                         std::span<const std::shared_ptr<const AnimationClip>> clips = {});
 
 /// An ellipsoid's unit sphere -> the space of `bone_global` (rigid part of the bone used).
 [[nodiscard]] Affine3 ellipsoid_transform(const EllipsoidShape& shape, const Affine3& bone_global);
