@@ -53,8 +53,11 @@ public:
                 c.velocity_m_s = (c.world.translation() - old_c) / Real(dt);
                 c.acceleration_m_s2 = c.initialised ? Vec3((c.velocity_m_s - old_v) / Real(dt)) : Vec3::Zero();
                 const Mat3 r0 = rotation_of(c.previous_world), r1 = rotation_of(c.world);
-                const Eigen::AngleAxis<Real> delta(r1 * r0.transpose());
-                c.angular_velocity_rad_s = delta.axis() * (delta.angle() / Real(dt));
+                Quat q(Mat3(r1 * r0.transpose()));
+                if (q.w() < 0) q.coeffs() = -q.coeffs();
+                const Real s = q.vec().norm();  // (AngleAxis would use stableNorm, which GCC 12 warns about with AVX-512)
+                const Real angle = 2 * std::atan2(s, q.w());
+                c.angular_velocity_rad_s = s > 0 ? Vec3(q.vec() / s * (angle / Real(dt))) : Vec3::Zero();
             }
             c.initialised = true;
         }

@@ -26,7 +26,7 @@ EllipsoidFrame tilted_ellipsoid() {
 
 TEST(Collision, ResponseMovesOntoTheSurfaceAlongTheCentreLineAndRemovesNormalVelocity) {
     const EllipsoidFrame f = tilted_ellipsoid();
-    for (const Vec3 local : {Vec3(0.3f, 0.2f, -0.5f), Vec3(-0.1f, 0.6f, 0.2f), Vec3(0.05f, -0.02f, 0.9f)}) {
+    for (const Vec3& local : {Vec3(0.3f, 0.2f, -0.5f), Vec3(-0.1f, 0.6f, 0.2f), Vec3(0.05f, -0.02f, 0.9f)}) {
         Vec3 x = f.center + f.rotation * f.radii_m.cwiseProduct(local);
         const Vec3 x0 = x;
         Vec3 v(-3, 1, 2);

@@ -51,7 +51,7 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringLongerThanTenPercentAfterTheConstra
     const bool classic = GetParam() == ClothModel::classic;
     int checks = 0;
     Real worst_layer2 = 0;
-    walk(body, registry, g, 120, [&](Garment& garment, const FrameContext& ctx) {
+    walk(body, registry, g, 120, [&](Garment& garment, const FrameContext&) {
         for (const SpringPhase* warp : {&t.warp1, &t.warp2}) {
             const bool exact = classic || warp == &t.warp1;
             for (std::size_t s = 0; s < warp->size(); ++s) {
@@ -95,7 +95,7 @@ TEST(Weft, LayerTwoParticlesLieOnTheirPlanesAfterTheConstraintSystem) {
     const GarmentTopology& t = *g.topology;
     Matrix3X normals(3, t.layer1_count);
     std::size_t checked = 0;
-    walk(body, registry, g, 90, [&](Garment& garment, const FrameContext& ctx) {
+    walk(body, registry, g, 90, [&](Garment& garment, const FrameContext&) {
         compute_layer1_normals(t, garment.x, normals);
         for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
             if (garment.inv_mass[t.weft_particle[k]] == 0) continue;
