@@ -722,6 +722,11 @@ Result<std::vector<std::uint8_t>> default_avatar_glb(const AvatarOptions& option
 }
 
 Result<void> write_avatar(const AvatarModel& model, const std::filesystem::path& path) {
+    const std::filesystem::path folder = path.parent_path();
+    std::error_code error;
+    if (!folder.empty() && !std::filesystem::is_directory(folder, error))
+        return fail(path.string() + ": cannot write, folder " + folder.string() + " does not exist");
+    if (std::filesystem::is_directory(path, error)) return fail(path.string() + ": is a folder, not a file");
     auto bytes = avatar_glb(model);
     if (!bytes) return std::unexpected(bytes.error());
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
