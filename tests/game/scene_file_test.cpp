@@ -228,9 +228,11 @@ TEST_F(SceneFileTest, DeepNestingIsAnErrorNotACrash) {
 
 TEST_F(SceneFileTest, CodeBuiltDescriptionsAreValidatedWithFieldNames) {
     SceneDescription scene;
-    scene.characters.push_back({.file = m_dir / "chars" / "body.glb"});
+    scene.characters.emplace_back();
+    scene.characters[0].file = m_dir / "chars" / "body.glb";
     EXPECT_TRUE(validate(scene));
-    scene.garments.push_back({.parameters = {{"particles", 5e6}}});
+    scene.garments.emplace_back();
+    scene.garments[0].parameters = {{"particles", 5e6}};
     auto r = validate(scene);
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().message, "garments[0].particles: must be an integer in [16, 1000000], got 5000000");

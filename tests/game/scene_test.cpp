@@ -1,0 +1,299 @@
+// Worlds built from scene descriptions: the sample scene plays headless and stays finite;
+// teleports reset the garment around the body; hitches are clamped; the time scale holds;
+// bad scenes fail with one error naming the field.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "components/skeleton.hpp"
+#include "components/transform.hpp"
+#include "game/scene.hpp"
+
+namespace drape {
+namespace {
+
+namespace fs = std::filesystem;
+
+SceneDescription sample() {
+    SceneDescription s = sample_scene();
+    if (!fs::exists(s.characters[0].file)) ADD_FAILURE() << "the default avatar is missing: " << s.characters[0].file;
+    return s;
+}
+
+void clear_locations(SceneDescription& s) {
+    for (auto& c : s.characters) c.where = {};
+    for (auto& g : s.garments) g.where = {};
+    for (auto& c : s.colliders) c.where = {};
+}
+
+Vec3 mean_position(const Garment& g) { return g.x.rowwise().mean(); }
+
+TEST(SampleScene, FileAndCodeDescribeTheSameScene) {
+    auto file = load_scene_file(asset_dir() / "scenes" / "sample.json");
+    ASSERT_TRUE(file) << file.error().message;
+    SceneDescription from_file = *file;
+    clear_locations(from_file);
+    SceneDescription from_code = sample();
+    from_code.characters[0].file = from_code.characters[0].file.lexically_normal();
+    EXPECT_EQ(from_file, from_code);
+}
+
+TEST(SampleScene, EverySceneInAssetsLoads) {
+    int scenes = 0;
+    for (const auto& entry : fs::directory_iterator(asset_dir() / "scenes")) {
+        if (entry.path().extension() != ".json") continue;
+        ++scenes;
+        auto scene = load_scene_file(entry.path());
+        EXPECT_TRUE(scene) << scene.error().message;
+    }
+    EXPECT_GE(scenes, 2);
+}
+
+TEST(SampleScene, PlaysHeadlessWithFiniteValues) {
+    auto world = build_world(sample(), {});
+    ASSERT_TRUE(world) << world.error().message;
+    ASSERT_EQ(world->characters.size(), 1u);
+    ASSERT_EQ(world->garments.size(), 1u);
+    EXPECT_EQ(world->renderer, nullptr);
+    for (int frame = 0; frame < 90; ++frame) {
+        auto report = step_world(*world, 1.0 / 60.0);
+        ASSERT_TRUE(report) << report.error().message;
+        ASSERT_FALSE(has_nonfinite(*world)) << "frame " << frame;
+    }
+    const RunStats stats = run_stats(*world);
+    EXPECT_EQ(stats.frames, 90u);
+    EXPECT_DOUBLE_EQ(stats.sim_dt_s, 1.0 / 60.0);
+    ASSERT_EQ(stats.garments.size(), 1u);
+    EXPECT_EQ(stats.garments[0].particles, 837u);  // the paper's skirt
+    EXPECT_EQ(stats.garments[0].nonfinite, 0u);
+    EXPECT_GT(stats.garments[0].collision_tests_per_frame, 0);
+    // No render system in a headless world; the cloth ran every step.
+    bool has_render = false, has_cloth = false;
+    for (const SystemStats& s : stats.systems) {
+        has_render |= s.name == "render";
+        if (s.name == "cloth_integration") has_cloth = s.runs >= 90;
+    }
+    EXPECT_FALSE(has_render);
+    EXPECT_TRUE(has_cloth);
+    // The skirt stays on the body: its centre near the character's vertical axis.
+    const Garment& g = world->registry.get<Garment>(world->garments[0]);
+    const Vec3 centre = mean_position(g);
+    EXPECT_LT(Vec3(centre.x(), 0, centre.z()).norm(), 0.3f);
+    EXPECT_GT(centre.y(), 0.4f);
+}
+
+TEST(TeleportGuard, JumpResetsTheGarmentAroundTheBodyAtItsNewPlace) {
+    auto world = build_world(sample(), {});
+    ASSERT_TRUE(world) << world.error().message;
+    for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_EQ(world->teleports->teleports, 0u);
+
+    world->registry.get<Transform>(world->characters[0]).position += Vec3(5, 0, 0);
+    ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_EQ(world->teleports->teleports, 1u);
+    EXPECT_EQ(world->teleports->resets, 1u);
+    const Garment& g = world->registry.get<Garment>(world->garments[0]);
+    EXPECT_TRUE(g.x.allFinite() && g.v.allFinite());
+    EXPECT_NEAR(mean_position(g).x(), 5.0f, 0.3f);
+    // The jump carried no velocity into the cloth.
+    EXPECT_LT(g.v.colwise().norm().maxCoeff(), 5.0f);
+    for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_FALSE(has_nonfinite(*world));
+    EXPECT_NEAR(mean_position(world->registry.get<Garment>(world->garments[0])).x(), 5.0f, 0.3f);
+    EXPECT_EQ(world->teleports->teleports, 1u);
+}
+
+TEST(TeleportGuard, AGameMovingItsCharacterIsNoTeleport) {
+    auto world = build_world(sample(), {});
+    ASSERT_TRUE(world) << world.error().message;
+    // Running at 6 m/s, moved by the game every frame, turning as it goes.
+    for (int frame = 0; frame < 150; ++frame) {
+        Transform& t = world->registry.get<Transform>(world->characters[0]);
+        t.rotation = Quat(Eigen::AngleAxis<Real>(Real(0.01) * frame, Vec3::UnitY()));
+        t.position += t.rotation * Vec3(0, 0, Real(6.0 / 60.0));
+        ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    }
+    EXPECT_EQ(world->teleports->teleports, 0u);
+    EXPECT_FALSE(has_nonfinite(*world));
+    // The skirt came along.
+    const Vec3 body = world->registry.get<Transform>(world->characters[0]).position;
+    const Vec3 skirt = mean_position(world->registry.get<Garment>(world->garments[0]));
+    EXPECT_LT(Vec3(skirt.x() - body.x(), 0, skirt.z() - body.z()).norm(), 0.4f);
+}
+
+TEST(TeleportGuard, ThresholdIsASolverSetting) {
+    SceneDescription scene = sample();
+    scene.solver.teleport_threshold_m = 10;
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    world->registry.get<Transform>(world->characters[0]).position += Vec3(5, 0, 0);
+    ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_EQ(world->teleports->teleports, 0u);
+}
+
+TEST(ExplicitReset, PutsTheGarmentBackAroundTheBody) {
+    auto world = build_world(sample(), {});
+    ASSERT_TRUE(world) << world.error().message;
+    for (int frame = 0; frame < 20; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    Garment& g = world->registry.get<Garment>(world->garments[0]);
+    g.x.colwise() += Vec3(0, 3, 0);  // fling it away
+    reset_garments(*world);
+    EXPECT_LT(std::abs(mean_position(world->registry.get<Garment>(world->garments[0])).y() - 0.8f), 0.5f);
+    EXPECT_EQ(world->teleports->resets, 1u);
+}
+
+TEST(Hitches, LongFramesAreClampedThenCapped) {
+    SceneDescription scene = sample();
+    scene.solver.max_frame_dt_s = 0.1;
+    scene.solver.max_steps_per_frame = 8;
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    // A 2 s hitch is clamped to 0.1 s: 6 steps of 1/60 s, nothing left to drop.
+    auto report = step_world(*world, 2.0);
+    ASSERT_TRUE(report);
+    EXPECT_EQ(report->steps, 6);
+    EXPECT_NEAR(world->scheduler.time_s(), 0.1, 1e-9);
+    EXPECT_FALSE(has_nonfinite(*world));
+    // A bad frame time is an error and nothing runs.
+    EXPECT_FALSE(step_world(*world, std::numeric_limits<double>::quiet_NaN()));
+    EXPECT_FALSE(step_world(*world, -1.0));
+    EXPECT_NEAR(world->scheduler.time_s(), 0.1, 1e-9);
+}
+
+TEST(TimeScale, HalfSpeedTakesHalfTheSteps) {
+    SceneDescription scene = sample();
+    scene.solver.time_scale = 0.5;
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    for (int frame = 0; frame < 60; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_NEAR(world->scheduler.time_s(), 0.5, 1e-9);
+    ASSERT_TRUE(set_time_scale(*world, 2.0));
+    for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_NEAR(world->scheduler.time_s(), 1.5, 1e-9);
+    auto bad = set_time_scale(*world, -1);
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("time_scale"), std::string::npos);
+}
+
+TEST(BuildWorld, BadScenesNameTheField) {
+    SceneDescription scene = sample();
+    ColliderOverride tail;
+    tail.bone = "Tail";
+    tail.radii_m = Vec3(0.1f, 0.1f, 0.1f);
+    scene.colliders.push_back(tail);
+    auto r = build_world(scene, {});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message.rfind("colliders[0].bone: no bone \"Tail\" in ", 0), 0u) << r.error().message;
+
+    scene = sample();
+    scene.characters[0].clip = "Moonwalk";
+    r = build_world(scene, {});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message.rfind("characters[0].clip: ", 0), 0u) << r.error().message;
+
+    // A character file of random bytes.
+    const fs::path junk = fs::temp_directory_path() / ("drape_scene_test_junk_" + std::to_string(::getpid()) + ".glb");
+    {
+        std::ofstream out(junk, std::ios::binary);
+        std::mt19937 rng(7);
+        for (int i = 0; i < 4096; ++i) out.put(static_cast<char>(rng() & 0xff));
+    }
+    scene = sample();
+    scene.characters[0].file = junk;
+    r = build_world(scene, {});
+    fs::remove(junk);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message.rfind("characters[0].file: ", 0), 0u) << r.error().message;
+    EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+}
+
+TEST(BuildWorld, ErrorsFromAFileCarryItsPosition) {
+    const fs::path dir = fs::temp_directory_path() / ("drape_scene_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path file = dir / "scene.json";
+    std::ofstream(file) << "{\"characters\": [{\"file\": \"" << default_avatar_path().string() << "\"}],\n"
+                        << " \"colliders\": [{\"bone\": \"Tail\", \"radii_m\": [0.1, 0.1, 0.1]}]}";
+    auto scene = load_scene_file(file);
+    ASSERT_TRUE(scene) << scene.error().message;
+    auto r = build_world(*scene, {});
+    fs::remove_all(dir);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message.rfind(file.string() + ":2:25: colliders[0].bone: no bone \"Tail\"", 0), 0u) << r.error().message;
+}
+
+TEST(BuildWorld, ColliderOverridesReshapeAndRemove) {
+    SceneDescription scene = sample();
+    // The bone that carries the fitted head ellipsoid.
+    std::string head_bone;
+    {
+        auto plain = build_world(scene, {});
+        ASSERT_TRUE(plain) << plain.error().message;
+        plain->registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+            if (c.region == BodyRegion::head)
+                head_bone = plain->registry.get<Skeleton>(plain->characters[0]).asset->bone_names.at(c.bone);
+        });
+        ASSERT_FALSE(head_bone.empty()) << "the avatar has no head ellipsoid";
+    }
+    ColliderOverride head_override, hips_override;
+    head_override.bone = head_bone;
+    head_override.remove = true;
+    hips_override.bone = "Hips";
+    hips_override.radii_m = Vec3(0.2f, 0.15f, 0.16f);
+    scene.colliders.push_back(head_override);
+    scene.colliders.push_back(hips_override);
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    int hips = 0, head = 0;
+    world->registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+        if (c.radii_m.isApprox(Vec3(0.2f, 0.15f, 0.16f))) ++hips;
+        if (c.region == BodyRegion::head) ++head;
+    });
+    EXPECT_GE(hips, 1);
+    EXPECT_EQ(head, 0);
+    for (int frame = 0; frame < 10; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    EXPECT_FALSE(has_nonfinite(*world));
+}
+
+// Property: random garment parameters within the documented ranges give a world that
+// steps with finite values, or one error line naming the garment. Bounded: 16 cases.
+TEST(BuildWorld, RandomGarmentParametersGiveAWorldOrOneError) {
+    std::mt19937 rng(2024);
+    int built = 0, rejected = 0;
+    for (int i = 0; i < 16; ++i) {
+        SceneDescription scene = sample();
+        GarmentDescription& g = scene.garments[0];
+        g.type = (i % 4 == 3) ? GarmentType::dress : GarmentType::skirt;
+        g.model = (i % 2) ? ClothModel::classic : ClothModel::simplified;
+        for (const GarmentParameterSpec& spec : garment_parameters(g.type)) {
+            if (rng() % 3 != 0) continue;
+            if (spec.name == "particles" || spec.name == "warp_lines" || spec.name == "particles_per_line") {
+                if (spec.name == "particles") g.parameters.push_back({"particles", double(100 + rng() % 1500)});
+                continue;  // keep each case small
+            }
+            std::uniform_real_distribution<double> u(spec.min, std::min(spec.max, spec.min + 10.0));
+            double v = u(rng);
+            if (spec.integer) v = std::round(v);
+            if (spec.min_exclusive && v <= spec.min) v = spec.min + 0.01;
+            g.parameters.push_back({std::string(spec.name), v});
+        }
+        auto world = build_world(scene, {});
+        if (!world) {
+            ++rejected;
+            EXPECT_EQ(world.error().message.rfind("garments[0]", 0), 0u) << world.error().message;
+            EXPECT_EQ(world.error().message.find('\n'), std::string::npos);
+            continue;
+        }
+        ++built;
+        for (int frame = 0; frame < 5; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+        EXPECT_FALSE(has_nonfinite(*world)) << to_json(scene);
+    }
+    EXPECT_EQ(built + rejected, 16);
+}
+
+}  // namespace
+}  // namespace drape
