@@ -123,6 +123,38 @@ TEST(DefaultAvatar, WeightsAreNormalisedWithAtMostFourInfluences) {
     }
 }
 
+// Skin weights fall off smoothly: around each knee, elbow and hip joint some vertices are
+// shared between the two bones (no hard seam), while mid-bone vertices follow one bone.
+TEST(DefaultAvatar, JointsBlendBetweenTheirTwoBones) {
+    const AvatarModel& m = avatar();
+    auto weight = [&](Eigen::Index v, int bone) {
+        for (int slot = 0; slot < 4; ++slot)
+            if (m.bone_indices(slot, v) == bone) return double(m.bone_weights(slot, v));
+        return 0.0;
+    };
+    for (const auto& [parent_name, child_name] : std::vector<std::pair<const char*, const char*>>{
+             {"LeftUpLeg", "LeftLeg"}, {"RightUpLeg", "RightLeg"}, {"LeftArm", "LeftForeArm"},
+             {"RightArm", "RightForeArm"}, {"Hips", "LeftUpLeg"}, {"Neck", "Head"}}) {
+        const int parent = m.find_bone(parent_name), child = m.find_bone(child_name);
+        ASSERT_GE(parent, 0);
+        ASSERT_GE(child, 0);
+        std::size_t shared = 0;
+        for (Eigen::Index v = 0; v < m.positions.cols(); ++v)
+            shared += weight(v, parent) >= 0.25 && weight(v, child) >= 0.25;
+        EXPECT_GE(shared, 10u) << parent_name << " / " << child_name;
+    }
+    // Halfway down the thigh, the skin follows the thigh alone.
+    const int thigh = m.find_bone("LeftUpLeg"), knee = m.find_bone("LeftLeg");
+    const double mid_y = 0.5 * (m.bones[std::size_t(thigh)].joint_m.y() + m.bones[std::size_t(knee)].joint_m.y());
+    std::size_t checked = 0;
+    for (Eigen::Index v = 0; v < m.positions.cols(); ++v)
+        if (std::abs(m.positions(1, v) - mid_y) < 0.01 && m.positions(0, v) > 0.03 && m.positions(0, v) < 0.25) {
+            EXPECT_GT(weight(v, thigh), 0.99) << "vertex " << v;
+            ++checked;
+        }
+    EXPECT_GT(checked, 5u);
+}
+
 // The A-pose keeps the hands clear of the hips and thighs (a dress hangs between them).
 TEST(DefaultAvatar, HandsHangClearOfTheBody) {
     const AvatarModel& m = avatar();
