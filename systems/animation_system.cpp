@@ -13,8 +13,8 @@ namespace drape {
 void advance_animation(AnimationPlayer& player, Skeleton& skeleton, Transform* transform, double dt_s) {
     if (!skeleton.asset) return;
     const SkeletonAsset& asset = *skeleton.asset;
-    if (player.clip && player.clip->duration_s > 0) {
-        if (player.playing && std::isfinite(player.speed)) {
+    if (player.clip) {
+        if (player.playing && std::isfinite(player.speed) && player.clip->duration_s > 0) {
             const ClipTime t = wrap_clip_time(player.time_s + dt_s * player.speed, player.clip->duration_s, player.loop);
             if (t.cycles != 0 && !player.in_place && transform != nullptr) {
                 // The pose jumps back by one cycle's travel; the character moves forward by it.
@@ -23,7 +23,7 @@ void advance_animation(AnimationPlayer& player, Skeleton& skeleton, Transform* t
             player.cycles += t.cycles;
             player.time_s = t.time_s;
         }
-        sample_clip(*player.clip, asset, player.time_s, player.in_place, skeleton.local);
+        sample_clip(*player.clip, asset, player.time_s, player.in_place, skeleton.local);  // a one-key clip is a pose
     } else {
         rest_pose(asset, skeleton.local);
     }
