@@ -76,9 +76,12 @@ std::uint64_t active_mask(std::span<const EllipsoidFrame> frames) {
 }
 
 std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
-                                    std::vector<std::uint64_t>& candidates) {
+                                    std::vector<std::uint64_t>& candidates, Matrix3X* scratch) {
     const Eigen::Index n = x.cols();
     candidates.assign(static_cast<std::size_t>(n), 0);
+    Matrix3X local_scratch;
+    Matrix3X& y = scratch ? *scratch : local_scratch;
+    y.resize(3, n);  // no allocation when the scratch is already sized
     std::uint64_t tests = 0;
     for (std::size_t e = 0; e < frames.size() && e < 64; ++e) {
         const EllipsoidFrame& f = frames[e];
@@ -86,8 +89,11 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
         const Real reach = 1 + margin / f.radii_m.minCoeff();
         const Real reach_sq = reach * reach;
         const std::uint64_t bit = std::uint64_t(1) << e;
+        // Whole-array unit-sphere map, then one compare per particle.
+        y.noalias() = f.to_unit * x;
+        const Vec3 offset = f.to_unit * f.center;
         for (Eigen::Index p = 0; p < n; ++p)
-            if ((f.to_unit * (x.col(p) - f.center)).squaredNorm() <= reach_sq) candidates[static_cast<std::size_t>(p)] |= bit;
+            if ((y.col(p) - offset).squaredNorm() <= reach_sq) candidates[static_cast<std::size_t>(p)] |= bit;
         tests += static_cast<std::uint64_t>(n);
     }
     return tests;
@@ -253,7 +259,7 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
         }
         slack = valid ? margin - frame_move - std::sqrt(particle_move_sq) : margin;
         if (!valid) {
-            const std::uint64_t tests = build_candidate_lists(g.x, g.frames, margin, g.candidates);
+            const std::uint64_t tests = build_candidate_lists(g.x, g.frames, margin, g.candidates, &g.force);
             g.list_anchor_x.resize(3, n);
             for (Eigen::Index p = 0; p < n; ++p) g.list_anchor_x.col(p) = to_anchor * (g.x.col(p) - anchor_origin);
             g.list_anchor_frames.resize(e_count);

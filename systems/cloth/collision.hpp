@@ -48,9 +48,10 @@ void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v);
 /// Bit set of the active frames.
 [[nodiscard]] std::uint64_t active_mask(std::span<const EllipsoidFrame> frames);
 
-/// Rebuilds every particle's candidate list (step 1). Returns the tests done.
+/// Rebuilds every particle's candidate list (step 1). Returns the tests done. `scratch`
+/// (3 x particles, reused between calls) avoids an allocation.
 std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin_m,
-                                    std::vector<std::uint64_t>& candidates);
+                                    std::vector<std::uint64_t>& candidates, Matrix3X* scratch = nullptr);
 
 /// What a collision pass did.
 struct CollisionResult {
