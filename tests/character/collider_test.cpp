@@ -196,5 +196,56 @@ TEST(CharacterSystems, SpawnRejectsAClipThatIsNotThere) {
     EXPECT_EQ(registry.alive(), 0u);
 }
 
+TEST(CharacterSystems, ColliderOverridesReplaceOrAddAndAreValidated) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    Registry registry;
+    SpawnOptions options;
+    EllipsoidShape big;
+    big.bone = c->skeleton->find("Child");
+    big.radii_m = Vec3(0.5f, 0.5f, 0.5f);
+    options.collider_overrides = {big};
+    options.replace_fitted_colliders = true;
+    auto e = spawn_character(registry, c, options);
+    ASSERT_TRUE(e) << e.error().message;
+    const auto only = colliders_of(registry, *e);
+    ASSERT_EQ(only.size(), 1u);
+    EXPECT_EQ(registry.get<EllipsoidCollider>(only[0]).radii_m, big.radii_m);
+    EXPECT_FALSE(registry.get<EllipsoidCollider>(only[0]).initialised);  // velocities start with the first step
+
+    options.collider_overrides[0].radii_m.y() = 0;
+    auto bad = spawn_character(registry, c, options);
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("colliders[0].radii_m: must be > 0"), std::string::npos) << bad.error().message;
+    options.collider_overrides[0].radii_m.y() = 0.5f;
+    options.collider_overrides[0].bone = 99;
+    bad = spawn_character(registry, c, options);
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("colliders[0].bone: out of range"), std::string::npos);
+}
+
+TEST(CharacterSystems, CollidersOfAMovingCharacterCarryItsVelocity) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    Registry registry;
+    SpawnOptions options;
+    options.speed = 0;  // hold the pose; only the Transform moves
+    auto e = spawn_character(registry, c, options);
+    ASSERT_TRUE(e);
+    Scheduler scheduler;
+    add_character_systems(scheduler);
+    const double dt = scheduler.settings().fixed_dt_s;
+    for (int i = 0; i < 5; ++i) {
+        registry.get<Transform>(*e).position.x() += Real(2.0 * dt);  // 2 m/s along X
+        ASSERT_TRUE(scheduler.tick(registry, dt));
+    }
+    for (Entity x : colliders_of(registry, *e)) {
+        const EllipsoidCollider& col = registry.get<EllipsoidCollider>(x);
+        EXPECT_TRUE(col.velocity_m_s.isApprox(Vec3(2, 0, 0), 1e-3f)) << col.velocity_m_s.transpose();
+        EXPECT_LE(col.acceleration_m_s2.norm(), 1e-2f);
+        EXPECT_LE(col.angular_velocity_rad_s.norm(), 1e-4f);
+    }
+}
+
 }  // namespace
 }  // namespace drape
