@@ -83,11 +83,16 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
     Matrix3X& y = scratch ? *scratch : local_scratch;
     y.resize(3, n);  // no allocation when the scratch is already sized
     std::uint64_t tests = 0;
+    if (n == 0) return 0;
+    const Vec3 low = x.rowwise().minCoeff(), high = x.rowwise().maxCoeff();
     for (std::size_t e = 0; e < frames.size() && e < 64; ++e) {
         const EllipsoidFrame& f = frames[e];
         if (!f.active) continue;
         const Real reach = 1 + margin / f.radii_m.minCoeff();
         const Real reach_sq = reach * reach;
+        // The reach region's bounding box misses the garment's: no particle can list it.
+        const Vec3 half = reach * (f.rotation * f.radii_m.asDiagonal()).rowwise().norm();
+        if (((f.center - half).array() > high.array()).any() || ((f.center + half).array() < low.array()).any()) continue;
         const std::uint64_t bit = std::uint64_t(1) << e;
         // Whole-array unit-sphere map, then one compare per particle.
         y.noalias() = f.to_unit * x;
