@@ -556,6 +556,11 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
         }
     }
     apply_root_correction(skeleton, *mesh, clips, Mat3::Identity(), static_cast<Real>(scale));
+    if (!mesh->bind_positions.allFinite())
+        return fail(where(path) + ": the bind pose is not finite (a singular node or bind matrix)");
+    for (std::size_t i = 0; i < bones; ++i)
+        if (!finite(skeleton.inverse_bind[i]) || !finite(skeleton.rest_local[i]))
+            return fail(where(path) + ": bone '" + skeleton.bone_names[i] + "' has a singular or non-finite transform");
     for (auto& clip : clips) compute_clip_travel(*clip, skeleton);
 
     std::vector<bool> moves(bones, false);
