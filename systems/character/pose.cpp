@@ -19,10 +19,13 @@ struct KeySpan {
 };
 
 KeySpan find_span(const std::vector<float>& times, double t) noexcept {
+    // Compare in the keys' own precision: a double just below the last key can round up
+    // to it in float, and the search must then take the end branch.
     const std::size_t n = times.size();
-    if (n <= 1 || t <= times.front()) return {0, 0, true};
-    if (t >= times.back()) return {n - 1, 0, true};
-    const auto upper = std::upper_bound(times.begin(), times.end(), static_cast<float>(t));
+    const auto tf = static_cast<float>(t);
+    if (n <= 1 || !(tf > times.front())) return {0, 0, true};
+    if (tf >= times.back()) return {n - 1, 0, true};
+    const auto upper = std::upper_bound(times.begin(), times.end(), tf);
     const std::size_t i = static_cast<std::size_t>(upper - times.begin()) - 1;
     const double span = double(times[i + 1]) - double(times[i]);
     const Real alpha = span > 0 ? static_cast<Real>((t - times[i]) / span) : Real(0);
