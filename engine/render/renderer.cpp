@@ -36,7 +36,8 @@ using render_detail::X11Window;
 Result<void> validate(const RenderSettings& s) {
     if (s.width < 16 || s.width > 8192) return fail("render settings: width: " + std::to_string(s.width) + " is outside 16..8192 px");
     if (s.height < 16 || s.height > 8192) return fail("render settings: height: " + std::to_string(s.height) + " is outside 16..8192 px");
-    if (s.msaa_samples < 0 || s.msaa_samples > 16) return fail("render settings: msaa_samples: " + std::to_string(s.msaa_samples) + " is outside 0..16");
+    if (s.msaa_samples < -1 || s.msaa_samples > 16)
+        return fail("render settings: msaa_samples: " + std::to_string(s.msaa_samples) + " is outside -1 (automatic)..16");
     if (!s.clear_color.allFinite() || (s.clear_color.array() < 0).any() || (s.clear_color.array() > 1).any())
         return fail("render settings: clear_color: each channel must be in 0..1");
     return {};
@@ -45,6 +46,12 @@ Result<void> validate(const RenderSettings& s) {
 namespace {
 
 constexpr int max_blobs = 8;
+
+/// The shaders' tone curve (shaders.cpp), for colours the CPU writes directly (the clear).
+Vec3 tone_map(const Vec3& linear) {
+    const Eigen::Array3f x = linear.array().max(Real(0));
+    return (x * (1 + x * Real(0.25)) / (1 + x)).sqrt().matrix();
+}
 
 std::uint64_t key_of(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
 
@@ -139,13 +146,16 @@ struct Renderer::Impl {
     GLuint draw_fbo = 0, draw_color = 0, draw_depth = 0;
     GLuint resolve_fbo = 0, resolve_color = 0;
     GLuint empty_vao = 0;
-    GLuint lit = 0, ground = 0, shadow = 0;
+    GLuint lit = 0, ground = 0, blob = 0, shadow = 0;
     struct {
         GLint view_projection, model, normal_matrix, color, eye, two_sided, specular, shininess, rim;
     } lit_u{};
     struct {
-        GLint view_projection, center, half_size, eye, sky, albedo, blob_count, blobs;
+        GLint view_projection, center, half_size, sky, albedo;
     } ground_u{};
+    struct {
+        GLint view_projection, blob;
+    } blob_u{};
     struct {
         GLint view_projection, shadow, darkness;
     } shadow_u{};
@@ -180,6 +190,7 @@ struct Renderer::Impl {
         glDeleteProgram(lit);
         glDeleteProgram(ground);
         glDeleteProgram(shadow);
+        glDeleteProgram(blob);
         glDeleteVertexArrays(1, &empty_vao);
         const GLuint fbos[2] = {draw_fbo, resolve_fbo};
         glDeleteFramebuffers(2, fbos);
@@ -201,7 +212,14 @@ struct Renderer::Impl {
 Result<void> Renderer::Impl::create_framebuffers() {
     GLint max_samples = 0;
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-    int samples = settings.msaa_samples <= 1 ? 0 : std::min(settings.msaa_samples, max_samples);
+    int requested = settings.msaa_samples;
+    if (requested < 0) {
+        const std::string& name = info.gl_renderer;
+        const bool software = name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos ||
+                              name.find("swrast") != std::string::npos;
+        requested = software ? 0 : 4;
+    }
+    int samples = requested <= 1 ? 0 : std::min(requested, max_samples);
     if (samples <= 1) samples = 0;
     info.msaa_samples = samples;
     const GLsizei w = settings.width, h = settings.height;
@@ -242,12 +260,15 @@ Result<void> Renderer::Impl::create_programs() {
                                           render_detail::shadow_fragment_shader);
     if (!s) return fail(s.error().message);
     shadow = *s;
+    auto b = render_detail::build_program("blob", render_detail::blob_vertex_shader, render_detail::blob_fragment_shader);
+    if (!b) return fail(b.error().message);
+    blob = *b;
     auto at = [](GLuint p, const char* n) { return glGetUniformLocation(p, n); };
     lit_u = {at(lit, "u_view_projection"), at(lit, "u_model"), at(lit, "u_normal_matrix"), at(lit, "u_color"),
              at(lit, "u_eye"), at(lit, "u_two_sided"), at(lit, "u_specular"), at(lit, "u_shininess"), at(lit, "u_rim")};
     ground_u = {at(ground, "u_view_projection"), at(ground, "u_center"), at(ground, "u_half_size"),
-                at(ground, "u_eye"), at(ground, "u_sky"), at(ground, "u_albedo"), at(ground, "u_blob_count"),
-                at(ground, "u_blobs")};
+                at(ground, "u_sky"), at(ground, "u_albedo")};
+    blob_u = {at(blob, "u_view_projection"), at(blob, "u_blob")};
     shadow_u = {at(shadow, "u_view_projection"), at(shadow, "u_shadow"), at(shadow, "u_darkness")};
     glCreateVertexArrays(1, &empty_vao);
     return {};
@@ -390,7 +411,7 @@ void Renderer::Impl::draw(Registry& registry) {
     // --- Clear ---------------------------------------------------------------------------
     glBindFramebuffer(GL_FRAMEBUFFER, draw_fbo);
     glViewport(0, 0, w, h);
-    const Vec3 clear = settings.clear_color.array().pow(Real(1 / 2.2));
+    const Vec3 clear = tone_map(settings.clear_color);
     glClearColor(clear.x(), clear.y(), clear.z(), 1);
     glClearStencil(0);
     glDepthMask(GL_TRUE);
@@ -406,13 +427,21 @@ void Renderer::Impl::draw(Registry& registry) {
     glUniformMatrix4fv(ground_u.view_projection, 1, GL_FALSE, view_projection.data());
     glUniform2f(ground_u.center, std::round(camera.target.x()), std::round(camera.target.z()));
     glUniform1f(ground_u.half_size, 80.0f);
-    glUniform3fv(ground_u.eye, 1, eye.data());
     glUniform3fv(ground_u.sky, 1, settings.clear_color.data());
     glUniform3f(ground_u.albedo, 0.38f, 0.37f, 0.35f);
-    glUniform1i(ground_u.blob_count, blob_count);
-    if (blob_count > 0) glUniform4fv(ground_u.blobs, blob_count, blobs[0].data());
     glBindVertexArray(empty_vao);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+
+    // --- Contact shadow blobs, multiplied into the ground ----------------------------------
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_DST_COLOR, GL_ZERO);
+    glUseProgram(blob);
+    glUniformMatrix4fv(blob_u.view_projection, 1, GL_FALSE, view_projection.data());
+    for (int i = 0; i < blob_count; ++i) {
+        glUniform4fv(blob_u.blob, 1, blobs[std::size_t(i)].data());
+        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    }
 
     // --- Planar shadows: every caster flattened onto the ground, each pixel darkened once.
     glUseProgram(shadow);
@@ -423,8 +452,6 @@ void Renderer::Impl::draw(Registry& registry) {
     glEnable(GL_STENCIL_TEST);
     glStencilFunc(GL_EQUAL, 0, 0xFF);
     glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-    glDepthMask(GL_FALSE);
-    glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     for (auto& [key, body] : bodies)
         if (body.mesh != nullptr) {

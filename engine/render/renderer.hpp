@@ -3,7 +3,7 @@
 // Off-screen it uses Mesa's surfaceless platform (EGL_MESA_platform_surfaceless) and falls
 // back to the EGL device platform (EGL_EXT_platform_device); no display or GPU is needed
 // (Mesa's llvmpipe renders on the CPU). In a window it uses an EGL window surface on X11.
-// Either way a frame is drawn into a framebuffer object (4x MSAA by default), resolved,
+// Either way a frame is drawn into a framebuffer object (4x MSAA on a GPU), resolved,
 // then read back (`read_pixels`) or shown (`present`).
 //
 // This header holds no EGL or GL type, so code outside engine/render builds the same with
@@ -32,8 +32,10 @@ struct RenderSettings {
     int width = 1280;                      ///< px, 16..8192.
     int height = 720;                      ///< px, 16..8192.
     RenderTarget target = RenderTarget::offscreen;
-    int msaa_samples = 4;                  ///< 0 or 1: off; otherwise 2, 4, 8 (capped by the driver).
-    Vec3 clear_color = Vec3(0.58f, 0.66f, 0.76f);  ///< Sky, linear RGB.
+    /// Multisample anti-aliasing: 0 or 1 off; 2, 4, 8, 16 (capped by the driver); -1 automatic:
+    /// 4 on a GPU, off on a software rasteriser (on llvmpipe 4x MSAA triples a frame's cost).
+    int msaa_samples = -1;
+    Vec3 clear_color = Vec3(0.45f, 0.60f, 0.82f);  ///< Sky, linear RGB.
     std::string window_title = "Drape";
     bool vsync = false;                    ///< Window only: wait for the display's refresh in present().
 };

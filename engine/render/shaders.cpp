@@ -1,6 +1,7 @@
 // Lighting (all programs agree): a warm key light from the upper left front, a cool fill
-// from the right back, a sky/ground hemisphere ambient; linear RGB in, a filmic shoulder,
-// then sRGB-like gamma 2.2 out (the frame buffer is plain RGBA8).
+// from the right back, a sky/ground hemisphere ambient; linear RGB in, a soft shoulder
+// x(1 + x/4)/(1 + x), then gamma 2 (sqrt) out: the frame buffer is plain RGBA8, and these
+// cost little on a software rasteriser (tone_map() in renderer.cpp is the same curve).
 #include "engine/render/shaders.hpp"
 
 #include <string>
@@ -17,8 +18,7 @@ namespace drape::render_detail {
     "const vec3 ground_color = vec3(0.17, 0.15, 0.13);\n"                                  \
     "vec3 tone(vec3 x) {\n"                                                                 \
     "    x = max(x, vec3(0.0));\n"                                                          \
-    "    vec3 mapped = x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);\n"          \
-    "    return pow(clamp(mapped, 0.0, 1.0), vec3(1.0 / 2.2));\n"                           \
+    "    return sqrt(x * (1.0 + x * 0.25) / (1.0 + x));\n"                                    \
     "}\n"
 
 const char* const lit_vertex_shader = R"(#version 450 core
@@ -57,7 +57,8 @@ void main() {
     vec3 ambient = mix(ground_color, sky_color, 0.5 + 0.5 * n.y);
     vec3 h = normalize(key_direction + v);
     float spec = key > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) * u_specular : 0.0;
-    float rim = pow(1.0 - max(dot(n, v), 0.0), 3.0) * u_rim;
+    float facing = 1.0 - max(dot(n, v), 0.0);
+    float rim = facing * facing * facing * u_rim;
     vec3 albedo = u_color.rgb;
     vec3 color = albedo * (key_color * key + fill_color * fill + ambient) + key_color * spec + sky_color * rim;
     o_color = vec4(tone(color), u_color.a);
@@ -68,43 +69,57 @@ const char* const ground_vertex_shader = R"(#version 450 core
 uniform mat4 u_view_projection;
 uniform vec2 u_center;       // ground quad centre (x, z), m
 uniform float u_half_size;   // m
-out vec3 v_world;
+out vec2 v_ground;           // world x, z
+out float v_depth;           // view depth, m (affine over the plane: interpolates exactly)
 void main() {
     const vec2 corners[4] = vec2[4](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
-    vec2 p = u_center + corners[gl_VertexID] * u_half_size;
-    v_world = vec3(p.x, 0.0, p.y);
-    gl_Position = u_view_projection * vec4(v_world, 1.0);
+    v_ground = u_center + corners[gl_VertexID] * u_half_size;
+    gl_Position = u_view_projection * vec4(v_ground.x, 0.0, v_ground.y, 1.0);
+    v_depth = gl_Position.w;
 }
 )";
 
 const char* const ground_fragment_shader = "#version 450 core\n" DRAPE_GLSL_LIGHTS R"(
-in vec3 v_world;
-uniform vec3 u_eye;
+in vec2 v_ground;
+in float v_depth;
 uniform vec3 u_sky;              // clear colour, linear: the horizon fades into it
 uniform vec3 u_albedo;
-uniform int u_blob_count;
-uniform vec4 u_blobs[8];         // centre x, centre z, radius m, strength 0..1
 out vec4 o_color;
 
-// Box-filtered checker (1 m tiles): no shimmer toward the horizon.
-float checker(vec2 p) {
-    vec2 w = max(fwidth(p), vec2(1e-4));
-    vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
-    return 0.5 - 0.5 * i.x * i.y;
-}
-
+// Cheap on a software rasteriser: 1 m checker tiles whose contrast fades with depth
+// (before they would alias), and fog on view depth rather than distance.
 void main() {
-    vec2 p = v_world.xz;
-    vec3 albedo = u_albedo * mix(0.86, 1.0, checker(p));
-    float occlusion = 1.0;
-    for (int i = 0; i < u_blob_count; ++i) {
-        float d = length(p - u_blobs[i].xy) / u_blobs[i].z;
-        occlusion *= 1.0 - u_blobs[i].w * (1.0 - smoothstep(0.2, 1.0, d));
-    }
-    vec3 color = albedo * (key_color * key_direction.y + sky_color) * occlusion;
-    float distance = length(u_eye - v_world);
-    float fog = smoothstep(12.0, 45.0, distance);
-    o_color = vec4(tone(mix(color, u_sky, fog)), 1.0);
+    vec2 cell = floor(v_ground);
+    float checker = fract((cell.x + cell.y) * 0.5) * 2.0;          // 0 or 1
+    float contrast = 0.14 * clamp(1.0 - v_depth * (1.0 / 18.0), 0.0, 1.0);
+    vec3 albedo = u_albedo * (1.0 - contrast * checker);
+    vec3 color = albedo * (key_color * key_direction.y + sky_color);
+    float fog = clamp((v_depth - 10.0) * (1.0 / 35.0), 0.0, 1.0);
+    o_color = vec4(tone(mix(color, u_sky, fog * fog * (3.0 - 2.0 * fog))), 1.0);
+}
+)";
+
+// A blob costs only the pixels it covers (a loop over blobs in the ground shader would
+// cost every ground pixel on a software rasteriser).
+const char* const blob_vertex_shader = R"(#version 450 core
+uniform mat4 u_view_projection;
+uniform vec4 u_blob;             // centre x, centre z, radius m, strength 0..1
+out vec2 v_offset;               // -1..1 across the blob
+void main() {
+    const vec2 corners[4] = vec2[4](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
+    v_offset = corners[gl_VertexID];
+    vec2 p = u_blob.xy + v_offset * u_blob.z;
+    gl_Position = u_view_projection * vec4(p.x, 0.001, p.y, 1.0);
+}
+)";
+
+const char* const blob_fragment_shader = R"(#version 450 core
+in vec2 v_offset;
+uniform vec4 u_blob;
+out vec4 o_color;
+void main() {
+    float occlusion = 1.0 - u_blob.w * (1.0 - smoothstep(0.2, 1.0, length(v_offset)));
+    o_color = vec4(vec3(sqrt(occlusion)), 1.0);   // multiplied into gamma-encoded colour
 }
 )";
 

@@ -14,6 +14,9 @@ extern const char* const lit_fragment_shader;
 /// The ground plane (drawn from gl_VertexID, no buffer) with blob contact shadows and fog.
 extern const char* const ground_vertex_shader;
 extern const char* const ground_fragment_shader;
+/// Soft contact shadows: a ground quad per blob, multiplied into the frame.
+extern const char* const blob_vertex_shader;
+extern const char* const blob_fragment_shader;
 /// Planar projected shadows onto the ground.
 extern const char* const shadow_vertex_shader;
 extern const char* const shadow_fragment_shader;

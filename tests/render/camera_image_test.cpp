@@ -101,7 +101,7 @@ TEST(RenderSettings, ValidationNamesTheField) {
     ASSERT_FALSE(ok.has_value());
     EXPECT_NE(ok.error().message.find("width"), std::string::npos);
     s = {};
-    s.msaa_samples = -1;
+    s.msaa_samples = -2;
     EXPECT_NE(validate(s).error().message.find("msaa_samples"), std::string::npos);
     s = {};
     s.clear_color = Vec3(2, 0, 0);

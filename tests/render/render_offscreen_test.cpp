@@ -81,6 +81,19 @@ TEST(RenderOffscreen, ContextIsOpenGL45OnASurfacelessOrDeviceDisplay) {
     EXPECT_EQ(info.msaa_samples, 4) << info.gl_renderer;
 }
 
+TEST(RenderOffscreen, AutomaticMultisamplingIsOffOnASoftwareRasteriser) {
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    ASSERT_EQ(settings.msaa_samples, -1);
+    auto renderer = Renderer::create(settings);
+    ASSERT_TRUE(renderer.has_value()) << renderer.error().message;
+    const RendererInfo& info = (*renderer)->info();
+    const bool software = info.gl_renderer.find("llvmpipe") != std::string::npos ||
+                          info.gl_renderer.find("softpipe") != std::string::npos;
+    EXPECT_EQ(info.msaa_samples, software ? 0 : 4) << info.gl_renderer;
+}
+
 TEST(RenderOffscreen, ReadPixelsBeforeAnyFrameIsAnError) {
     auto renderer = make_renderer();
     ASSERT_TRUE(renderer);
