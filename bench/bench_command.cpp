@@ -23,6 +23,7 @@ const std::vector<Benchmark>& benchmarks() {
         {"scale", "garment size, walker count and threads; microseconds per particle per frame", run_scale},
         {"peers", "Bullet soft-body cloth against Drape on the same skirt and ellipsoids", run_peers},
         {"render", "off-screen rendering at 1280x720, ms per frame", run_render},
+        {"soak", "the sample scene walking for an hour of simulated time: drift per minute", run_soak},
     };
     return list;
 }
@@ -76,8 +77,12 @@ void add_bench_command(CLI::App& app) {
         }
         const bool runs_set = command->count("--runs") > 0;
         const bool threads_set = command->count("--threads") > 0;
-        tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
-                                    static_cast<std::size_t>(cli->threads));
+        // --threads caps every world (tbb::global_control); without it each benchmark sets
+        // its worlds' threads itself (1 by default; `scale` compares 1 and 2).
+        std::unique_ptr<tbb::global_control> threads;
+        if (threads_set)
+            threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                            static_cast<std::size_t>(cli->threads));
         int failures = 0;
         for (const auto* b : selected) {
             bench::BenchOptions options;

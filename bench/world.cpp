@@ -27,6 +27,7 @@ SceneDescription scene_for(const WorldSpec& spec) {
         scene.garments.push_back(g);
     }
     scene.solver.substeps = spec.substeps;
+    scene.solver.fixed_dt_s = spec.fixed_dt_s;
     scene.solver.time_scale = spec.time_scale;
     scene.solver.threads = spec.threads;
     return scene;
@@ -41,6 +42,7 @@ Result<World> build_bench_world(const WorldSpec& spec) {
     }
     WorldOptions options;
     options.profile = spec.profile;
+    options.render = spec.render;
     return build_world(scene, options);
 }
 

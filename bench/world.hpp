@@ -18,10 +18,12 @@ struct WorldSpec {
     CollisionMode collision = CollisionMode::candidate_lists;
     int particles = 0;                                 ///< 0: the builder's default.
     int substeps = 0;                                  ///< 0: the cloth's stability rule.
+    double fixed_dt_s = 1.0 / 60.0;                    ///< Simulated time per fixed step.
     double time_scale = 1;
     int threads = 1;
     bool profile = true;                               ///< Time every system run.
     bool in_place = true;                              ///< false: root motion moves the walkers.
+    bool render = false;                               ///< Off-screen renderer + render system (1280x720).
 };
 
 /// The scene description of a spec (default avatar, its walk, in place).
