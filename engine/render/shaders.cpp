@@ -138,6 +138,18 @@ void main() { o_color = vec4(0.0, 0.0, 0.0, u_darkness); }
 
 namespace {
 
+/// A GL info log as one line: trailing blanks dropped, line breaks turned into "; ".
+std::string one_line(std::string log) {
+    while (!log.empty() && (log.back() == '\0' || log.back() == '\n' || log.back() == ' ')) log.pop_back();
+    std::string out;
+    out.reserve(log.size());
+    for (char c : log) {
+        if (c == '\n') out += "; ";
+        else if (c != '\0') out += c;
+    }
+    return out;
+}
+
 Result<GLuint> compile(std::string_view program, GLenum stage, const char* source) {
     const GLuint shader = glCreateShader(stage);
     glShaderSource(shader, 1, &source, nullptr);
@@ -150,9 +162,8 @@ Result<GLuint> compile(std::string_view program, GLenum stage, const char* sourc
     std::string log(static_cast<std::size_t>(length > 0 ? length : 1), '\0');
     glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
     glDeleteShader(shader);
-    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
     return fail("shader " + std::string(program) + (stage == GL_VERTEX_SHADER ? " (vertex)" : " (fragment)") +
-                ": compile error: " + log);
+                ": compile error: " + one_line(std::move(log)));
 }
 
 }  // namespace
@@ -179,8 +190,7 @@ Result<GLuint> build_program(std::string_view name, const char* vertex_source, c
     std::string log(static_cast<std::size_t>(length > 0 ? length : 1), '\0');
     glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
     glDeleteProgram(program);
-    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
-    return fail("shader " + std::string(name) + ": link error: " + log);
+    return fail("shader " + std::string(name) + ": link error: " + one_line(std::move(log)));
 }
 
 }  // namespace drape::render_detail

@@ -9,6 +9,7 @@
 
 #include "engine/core/scheduler.hpp"
 #include "engine/render/renderer.hpp"
+#include "engine/render/shaders.hpp"
 #include "systems/render_system.hpp"
 #include "tests/render/test_scene.hpp"
 
@@ -92,6 +93,25 @@ TEST(RenderOffscreen, AutomaticMultisamplingIsOffOnASoftwareRasteriser) {
     const bool software = info.gl_renderer.find("llvmpipe") != std::string::npos ||
                           info.gl_renderer.find("softpipe") != std::string::npos;
     EXPECT_EQ(info.msaa_samples, software ? 0 : 4) << info.gl_renderer;
+}
+
+TEST(RenderOffscreen, ShaderErrorsNameTheProgramTheStageAndTheLog) {
+    auto renderer = make_renderer();  // a current context
+    ASSERT_TRUE(renderer);
+    auto broken = render_detail::build_program("broken", render_detail::lit_vertex_shader,
+                                               "#version 450 core\nout vec4 o;\nvoid main() { o = no_such_thing; }\n");
+    ASSERT_FALSE(broken.has_value());
+    const std::string& message = broken.error().message;
+    EXPECT_NE(message.find("shader broken (fragment): compile error"), std::string::npos) << message;
+    EXPECT_NE(message.find("no_such_thing"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
+    // Stages that compile but do not link (the fragment stage reads what no vertex stage writes).
+    auto unlinked = render_detail::build_program(
+        "unlinked", "#version 450 core\nvoid main() { gl_Position = vec4(0.0); }\n",
+        "#version 450 core\nin vec3 v_missing;\nout vec4 o;\nvoid main() { o = vec4(v_missing, 1.0); }\n");
+    ASSERT_FALSE(unlinked.has_value());
+    EXPECT_NE(unlinked.error().message.find("shader unlinked: link error"), std::string::npos)
+        << unlinked.error().message;
 }
 
 TEST(RenderOffscreen, ReadPixelsBeforeAnyFrameIsAnError) {
