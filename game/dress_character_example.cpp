@@ -45,7 +45,7 @@ int particles_inside(drape::Registry& registry, const drape::Garment& garment) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const std::string file = argc > 1 ? argv[1] : drape::default_avatar_path().string();
+    const std::string file = argc > 1 && *argv[1] != 0 ? argv[1] : drape::default_avatar_path().string();
     const std::string clip = argc > 2 ? argv[2] : "";
     const int frames = argc > 3 ? std::atoi(argv[3]) : 300;
     if (frames <= 0) return fail_with("FRAMES must be a positive integer");

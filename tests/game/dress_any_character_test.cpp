@@ -1,0 +1,85 @@
+// Dressing characters no one here made, as a new user would through a scene description:
+// the third-party characters in ../shared/assets/characters, each in a skirt and in a
+// dress. The garment must sit on the body (around its hips), no free particle may end
+// inside an ellipsoid, and nothing may go non-finite.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "game/scene.hpp"
+
+namespace drape {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Character {
+    const char* file;
+    const char* clip;
+};
+
+const Character characters[] = {
+    {"characters/male_casual/Male_Casual.fbx", "HumanArmature|Man_Walk"},
+    {"characters/robot_expressive/RobotExpressive.glb", "Walking"},
+    {"characters/rigged_simple/RiggedSimple.glb", ""},
+};
+
+// Free particles inside an ellipsoid of the garment's body (1 % inside the surface).
+int particles_inside(World& world, const Garment& g) {
+    int inside = 0;
+    for (Eigen::Index i = 0; i < g.x.cols(); ++i) {
+        if (g.inv_mass[i] == 0) continue;  // pinned to the skin
+        bool in = false;
+        world.registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+            if (c.character == g.body && (c.world.inverse() * g.x.col(i)).norm() < 0.99f) in = true;
+        });
+        inside += in ? 1 : 0;
+    }
+    return inside;
+}
+
+void dress_and_walk(const Character& c, GarmentType type) {
+    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
+    if (!fs::exists(file)) GTEST_SKIP() << file << " is absent (the shared third-party characters are optional)";
+    SceneDescription scene;
+    scene.characters.emplace_back();
+    scene.characters[0].file = file;
+    scene.characters[0].clip = c.clip;
+    scene.garments.emplace_back();
+    scene.garments[0].type = type;
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    for (int frame = 0; frame < 120; ++frame) {
+        ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+        ASSERT_FALSE(has_nonfinite(*world)) << "frame " << frame;
+    }
+    const Garment& g = world->registry.get<Garment>(world->garments[0]);
+    EXPECT_EQ(particles_inside(*world, g), 0);
+    // On the body: the garment's centre is near its anchor ellipsoid (hips or chest) horizontally.
+    ASSERT_GE(g.anchor, 0);
+    const Vec3 anchor = world->registry.get<EllipsoidCollider>(g.colliders.at(static_cast<std::size_t>(g.anchor))).world.translation();
+    const Vec3 centre = g.x.rowwise().mean();
+    EXPECT_LT(Vec3(centre.x() - anchor.x(), 0, centre.z() - anchor.z()).norm(), 0.25f);
+    // Hanging from its fitting ring: the garment's centre is below its pinned particles.
+    Vec3 ring = Vec3::Zero();
+    int pinned = 0;
+    for (Eigen::Index i = 0; i < g.x.cols(); ++i)
+        if (g.inv_mass[i] == 0) {
+            ring += g.x.col(i);
+            ++pinned;
+        }
+    ASSERT_GT(pinned, 0);
+    EXPECT_LT(centre.y(), ring.y() / Real(pinned));
+    EXPECT_EQ(run_stats(*world).garments.at(0).nonfinite, 0u);
+}
+
+TEST(DressAnyCharacter, MaleCasualInASkirt) { dress_and_walk(characters[0], GarmentType::skirt); }
+TEST(DressAnyCharacter, RobotExpressiveInASkirt) { dress_and_walk(characters[1], GarmentType::skirt); }
+TEST(DressAnyCharacter, RiggedSimpleInASkirt) { dress_and_walk(characters[2], GarmentType::skirt); }
+TEST(DressAnyCharacter, MaleCasualInADress) { dress_and_walk(characters[0], GarmentType::dress); }
+TEST(DressAnyCharacter, RobotExpressiveInADress) { dress_and_walk(characters[1], GarmentType::dress); }
+
+}  // namespace
+}  // namespace drape
