@@ -78,6 +78,16 @@ TEST(ClipSampling, TimeOutsideTheKeysHoldsTheEndKeys) {
     EXPECT_TRUE(local[0].translation().isApprox(Vec3(0, 0, 2)));
 }
 
+TEST(ClipSampling, TimeThatRoundsUpToTheLastKeyInFloatHoldsTheLastKey) {
+    auto s = chain();
+    auto clip = bend_and_walk();
+    std::vector<Affine3> local;
+    sample_clip(*clip, *s, std::nextafter(1.0, 0.0), false, local);  // rounds to 1.0f
+    EXPECT_TRUE(local[0].translation().isApprox(Vec3(0, 0, 2)));
+    sample_clip(*clip, *s, std::nan(""), false, local);
+    EXPECT_TRUE(local[0].matrix().allFinite());
+}
+
 TEST(ClipSampling, InPlaceRemovesTheTravelButKeepsTheRest) {
     auto s = chain();
     auto clip = bend_and_walk();
