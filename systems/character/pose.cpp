@@ -103,6 +103,7 @@ void rest_pose(const SkeletonAsset& skeleton, std::vector<Affine3>& local) {
 void sample_clip(const AnimationClip& clip, const SkeletonAsset& skeleton, double time_s, bool in_place,
                  std::vector<Affine3>& local) {
     rest_pose(skeleton, local);
+    if (!std::isfinite(time_s)) time_s = 0;  // never let a bad clock reach the pose
     const int bones = static_cast<int>(skeleton.size());
     for (const BoneChannel& c : clip.channels) {
         if (c.bone < 0 || c.bone >= bones) continue;
