@@ -96,20 +96,14 @@ bool source_format_contains(const aiScene* scene, std::string_view what) {
     return std::string_view(format.C_Str()).find(what) != std::string_view::npos;
 }
 
-// FBX axis metadata -> rotation into Drape's axes (X right, Y up, Z front).
+// FBX axis metadata of a scene -> rotation into Drape's axes.
 Mat3 fbx_axes(const aiScene* scene) {
     const auto up = metadata_any(scene, "UpAxis"), up_sign = metadata_any(scene, "UpAxisSign");
     const auto front = metadata_any(scene, "FrontAxis"), front_sign = metadata_any(scene, "FrontAxisSign");
     const auto coord = metadata_any(scene, "CoordAxis"), coord_sign = metadata_any(scene, "CoordAxisSign");
     if (!up || !front || !coord) return Mat3::Identity();
-    const int u = int(*up), f = int(*front), c = int(*coord);
-    if (u < 0 || u > 2 || f < 0 || f > 2 || c < 0 || c > 2 || u == f || u == c || f == c) return Mat3::Identity();
-    Mat3 m = Mat3::Zero();
-    m(0, c) = coord_sign && *coord_sign < 0 ? -1 : 1;
-    m(1, u) = up_sign && *up_sign < 0 ? -1 : 1;
-    m(2, f) = front_sign && *front_sign < 0 ? -1 : 1;
-    if (m.determinant() < 0) m.row(0) *= -1;  // keep it a rotation (right-handed)
-    return m;
+    return axes_to_drape(int(*up), up_sign && *up_sign < 0 ? -1 : 1, int(*front), front_sign && *front_sign < 0 ? -1 : 1,
+                         int(*coord), coord_sign && *coord_sign < 0 ? -1 : 1);
 }
 
 struct Builder {
@@ -451,6 +445,17 @@ Real rest_height(const SkeletonAsset& skeleton, const MeshAsset& mesh) {
 }
 
 }  // namespace
+
+Mat3 axes_to_drape(int up, int up_sign, int front, int front_sign, int coord, int coord_sign) {
+    if (up < 0 || up > 2 || front < 0 || front > 2 || coord < 0 || coord > 2 || up == front || up == coord || front == coord)
+        return Mat3::Identity();
+    Mat3 m = Mat3::Zero();
+    m(0, coord) = coord_sign < 0 ? -1 : 1;
+    m(1, up) = up_sign < 0 ? -1 : 1;
+    m(2, front) = front_sign < 0 ? -1 : 1;
+    if (m.determinant() < 0) m.row(0) *= -1;  // keep it a rotation: the right axis follows from up and front
+    return m;
+}
 
 Result<void> validate(const ImportOptions& o) {
     if (o.scale && !(std::isfinite(*o.scale) && *o.scale > 0)) return fail("scale: must be a finite number > 0");

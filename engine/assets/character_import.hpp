@@ -38,6 +38,11 @@ struct ImportOptions {
 /// Checks the options; the error names the field.
 [[nodiscard]] Result<void> validate(const ImportOptions& options);
 
+/// The rotation from a file's axes to Drape's (X right, Y up, Z front), given which file
+/// axis (0 = X, 1 = Y, 2 = Z) and sign is up, front and right (FBX's UpAxis, FrontAxis,
+/// CoordAxis metadata). Identity when the axes are not a permutation.
+[[nodiscard]] Mat3 axes_to_drape(int up, int up_sign, int front, int front_sign, int coord, int coord_sign);
+
 /// Imports a character file.
 [[nodiscard]] Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesystem::path& path,
                                                                              const ImportOptions& options = {});

@@ -107,6 +107,16 @@ TEST(CharacterImport, ClipsAreFoundByNameOrIndex) {
     EXPECT_FALSE(find_clip(*c, "1"));
 }
 
+TEST(CharacterImport, FbxAxisMetadataBecomesYUp) {
+    EXPECT_TRUE(axes_to_drape(1, 1, 2, 1, 0, 1).isIdentity());  // Blender's Y-up export
+    // Z up, -Y front (Blender's own axes): file Z -> Y, file -Y -> Z.
+    const Mat3 z_up = axes_to_drape(2, 1, 1, -1, 0, 1);
+    EXPECT_TRUE((z_up * Vec3(0, 0, 1)).isApprox(Vec3(0, 1, 0)));
+    EXPECT_TRUE((z_up * Vec3(0, -1, 0)).isApprox(Vec3(0, 0, 1)));
+    EXPECT_NEAR(z_up.determinant(), 1.0f, 1e-6f);
+    EXPECT_TRUE(axes_to_drape(1, 1, 1, 1, 0, 1).isIdentity());  // not a permutation
+}
+
 TEST(CharacterImport, OptionsAreValidatedWithTheFieldName) {
     ImportOptions bad;
     bad.scale = -1;
