@@ -3,6 +3,7 @@
 // budget. Usage and options: README.md "Playing scenes" and `drape play --help`.
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -37,6 +38,10 @@ struct PlayOptions {
     double fps = 60;
     bool headless = false, window = false;
 };
+
+// Ctrl-C stops the loop between frames, so the video, stats and trace are still complete.
+volatile std::sig_atomic_t g_interrupted = 0;
+void on_interrupt(int) { g_interrupted = 1; }
 
 // Errors of this command: "drape play: --size: must be WxH ..." on stderr, exit code 1.
 int report(const std::string& message) {
@@ -208,7 +213,9 @@ int play(const PlayOptions& o) {
     bool paused = false;
     auto last = std::chrono::steady_clock::now();
 #endif
-    while (frames == 0 || played < frames) {
+    g_interrupted = 0;
+    const auto previous_handler = std::signal(SIGINT, on_interrupt);
+    while ((frames == 0 || played < frames) && !g_interrupted) {
         double dt = frame_dt_s;
 #ifdef DRAPE_HAVE_RENDER
         if (window) {
@@ -256,8 +263,10 @@ int play(const PlayOptions& o) {
         }
 #endif
     }
+    std::signal(SIGINT, previous_handler);
     if (video)
         if (auto ok = video->close(); !ok) return report(ok.error().message);
+    if (g_interrupted) std::printf("drape play: interrupted after %d frames\n", played);
 
     // --- Reports.
     std::fputs(world.scheduler.profiler().table().c_str(), stdout);

@@ -57,7 +57,10 @@ Result<VideoWriter> VideoWriter::open(const std::filesystem::path& file, int wid
     // A dead ffmpeg must turn into a write error, not kill Drape with SIGPIPE.
     std::signal(SIGPIPE, SIG_IGN);
     const std::string size = std::to_string(width) + "x" + std::to_string(height);
-    const std::string command = shell_quote(ffmpeg->string()) +
+    // ffmpeg runs in its own session when setsid exists: Ctrl-C in the terminal then stops
+    // Drape between frames (which closes the video properly), not ffmpeg mid-stream.
+    const bool setsid = ::access("/usr/bin/setsid", X_OK) == 0;
+    const std::string command = std::string(setsid ? "exec /usr/bin/setsid " : "exec ") + shell_quote(ffmpeg->string()) +
                                 " -nostdin -hide_banner -loglevel error -y -f rawvideo -pixel_format rgba -video_size " + size +
                                 " -framerate " + std::to_string(fps) +
                                 " -i - -vf " + shell_quote("scale=trunc(iw/2)*2:trunc(ih/2)*2") + " -c:v libx264 -preset veryfast -crf 20"
