@@ -512,10 +512,9 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
         return fail(where(path) + ": not a readable model (" + (why.empty() ? "unknown format" : why) + ")");
     }
     if (scene->mRootNode == nullptr || scene->mNumMeshes == 0) return fail(where(path) + ": no meshes");
-    if (options.require_animation && scene->mNumAnimations == 0) return fail(where(path) + ": no animation");
-
     Builder b(path, scene);
     if (auto ok = build_skeleton(b); !ok) return std::unexpected(ok.error());
+    if (options.require_animation && scene->mNumAnimations == 0) return fail(where(path) + ": no animation");
     collect_inverse_binds(b);
     auto mesh = std::make_shared<MeshAsset>();
     auto asset = std::make_shared<CharacterAsset>();

@@ -70,6 +70,7 @@ TEST_F(BadInput, TruncatedBinaryGlb) {
 
 TEST_F(BadInput, NoSkeleton) {
     test::write_test_character({.skin = false, .animation = false}, dir / "statue.gltf");
+    expect_error(dir / "statue.gltf", "no skeleton");
     expect_error(dir / "statue.gltf", "no skeleton", test_options(false));
 }
 
