@@ -509,6 +509,8 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
                                                                 aiProcess_ValidateDataStructure);
     if (scene == nullptr) {
         std::string why = one_line(importer.GetErrorString());
+        if (why.find("mNumMeshes is 0") != std::string::npos)  // assimp's validation of a mesh-less scene
+            return fail(where(path) + ": no meshes" + (path.extension() == ".bvh" ? " (a BVH file holds motion only)" : ""));
         return fail(where(path) + ": not a readable model (" + (why.empty() ? "unknown format" : why) + ")");
     }
     if (scene->mRootNode == nullptr || scene->mNumMeshes == 0) return fail(where(path) + ": no meshes");
