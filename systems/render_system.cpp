@@ -8,7 +8,6 @@
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
 #include "components/skinned_mesh.hpp"
-#include "components/transform.hpp"
 
 namespace drape {
 
@@ -52,7 +51,7 @@ System make_render_system(Renderer& renderer) {
     system.name = "render";
     system.phase = Phase::render;
     system.reads = components<SkinnedMesh>();
-    system.optional_reads = components<Garment, EllipsoidCollider, Transform, Character>();
+    system.optional_reads = components<Garment, EllipsoidCollider, Character>();
     system.run = [&renderer, first = true](Registry& registry, const FrameContext& context) mutable {
         update_follow_camera(renderer.camera(), registry, first ? 0.0 : context.frame_dt_s);
         first = false;

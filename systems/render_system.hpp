@@ -1,10 +1,12 @@
 // The render system: draws the scene through a Renderer once per frame (phase render).
 //
-// Reads SkinnedMesh (gates the run); reads Garment, EllipsoidCollider, Transform and
-// Character when present. Before drawing it moves the camera's target to the first
-// character (the one with the lowest entity index) when `Camera::follow` is set.
+// Reads SkinnedMesh (gates the run); reads Garment, EllipsoidCollider and Character when
+// present. Before drawing it moves the camera's target to the first character (the one
+// with the lowest entity index) when `Camera::follow` is set. The target comes from the
+// skinned vertices themselves, so it follows root motion and in-place clips alike.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "engine/core/error.hpp"
