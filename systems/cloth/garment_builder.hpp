@@ -57,7 +57,10 @@ struct DressParams {
     Real shoulder_height_m = 0;
     Real torso_radius_fraction = Real(0.12);
     int fitting_rows = 2;
-    ClothMaterial material{.mass_kg = Real(0.6)};
+    /// Per-spring stiffness and per-particle drag scaled to the finer grid (same cloth as
+    /// the skirt per unit area), so that the default dress needs one substep too.
+    ClothMaterial material{.mass_kg = Real(0.6), .stretch_k_N_m = Real(0.12), .shear_k_N_m = Real(0.06),
+                           .bend_k_N_m = Real(0.03), .drag_N_s_m = Real(0.00018)};
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.15f, 0.3f, 0.7f);
