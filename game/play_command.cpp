@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include "game/commands.hpp"
 #include "game/scene.hpp"
@@ -188,7 +189,14 @@ int play(const PlayOptions& o) {
     options.width = size.first;
     options.height = size.second;
     auto built = build_world(scene, options);
-    if (!built) return report(built.error().message);
+    if (!built) {
+        // A value from the command line is named as the option the user typed.
+        std::string message = built.error().message;
+        for (const auto& [field, option, given] : {std::tuple{"characters[0].clip: ", "--clip: ", !o.clip.empty()},
+                                                   std::tuple{"characters[0].file: ", "--character: ", !o.character.empty()}})
+            if (given && message.rfind(field, 0) == 0) message = option + message.substr(std::string_view(field).size());
+        return report(message);
+    }
     World& world = *built;
 
     const int frames = o.frames.value_or(window ? 0 : 240);  // window: until closed unless --frames

@@ -68,7 +68,7 @@ TEST_F(PlayCommand, BadValuesGiveOneLineNamingTheOption) {
         {"--headless --stats no/such/folder/stats.json", "drape play: --stats: folder no/such/folder does not exist\n"},
         {"--scene nothing.json", "drape play: nothing.json: no such scene file\n"},
         {"--headless --clip Moonwalk",
-         "drape play: characters[0].clip: " + std::string(DRAPE_SOURCE_DIR) + "/assets/avatar.glb: no clip named 'Moonwalk' (clips: 'Walk', 'Idle')\n"},
+         "drape play: --clip: " + std::string(DRAPE_SOURCE_DIR) + "/assets/avatar.glb: no clip named 'Moonwalk' (clips: 'Walk', 'Idle')\n"},
     };
     for (const Case& c : cases) {
         const PlayRun run = play(c.args, m_dir);
