@@ -27,8 +27,10 @@ std::optional<Vec3> follow_target(Registry& registry, const Camera& camera) {
         chosen_index = e.index;
     });
     if (chosen == nullptr) return std::nullopt;
-    const Vec3 lo = chosen->positions.rowwise().minCoeff(), hi = chosen->positions.rowwise().maxCoeff();
-    if (!lo.allFinite() || !hi.allFinite()) return std::nullopt;
+    const auto bounds = finite_bounds(chosen->positions);
+    if (!bounds) return std::nullopt;
+    const Vec3& lo = bounds->lo;
+    const Vec3& hi = bounds->hi;
     return Vec3(Real(0.5) * (lo.x() + hi.x()), lo.y() + camera.follow_height_ratio * (hi.y() - lo.y()),
                 Real(0.5) * (lo.z() + hi.z()));
 }

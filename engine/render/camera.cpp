@@ -2,8 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace drape {
+
+std::optional<Bounds> finite_bounds(const Matrix3X& points) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity()), hi = -lo;
+    bool any = false;
+    for (Eigen::Index i = 0; i < points.cols(); ++i) {
+        const Vec3 p = points.col(i);
+        if (!p.allFinite()) continue;
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+        any = true;
+    }
+    if (!any) return std::nullopt;
+    return Bounds{lo, hi};
+}
 
 Vec3 Camera::eye() const {
     const Real cp = std::cos(pitch_rad);

@@ -18,6 +18,14 @@ struct ScreenPoint {
     float depth = 0;  ///< Normalised device depth, -1 (near) .. 1 (far).
 };
 
+/// Axis-aligned bounds of the finite points of a point set (non-finite points are
+/// skipped, so one NaN vertex cannot move the camera or a shadow); nullopt when none is.
+struct Bounds {
+    Vec3 lo;
+    Vec3 hi;
+};
+[[nodiscard]] std::optional<Bounds> finite_bounds(const Matrix3X& points);
+
 struct Camera {
     Vec3 target = Vec3(0, 1, 0);   ///< m, the point looked at.
     Real yaw_rad = Real(0.6);

@@ -348,12 +348,13 @@ void Renderer::Impl::draw(Registry& registry) {
         // Contact shadow: a soft blob under the footprint of the body's lowest quarter (the
         // feet and legs, not the swinging arms), fading as the body leaves the ground.
         if (blob_count < max_blobs) {
-            const Vec3 lo = skin.positions.rowwise().minCoeff(), hi = skin.positions.rowwise().maxCoeff();
-            if (lo.allFinite() && hi.allFinite()) {
+            if (const auto bounds = finite_bounds(skin.positions)) {
+                const Vec3& lo = bounds->lo;
+                const Vec3& hi = bounds->hi;
                 const Real feet_top = lo.y() + Real(0.25) * (hi.y() - lo.y());
                 Eigen::Vector2f feet_lo(hi.x(), hi.z()), feet_hi(lo.x(), lo.z());
                 for (Eigen::Index i = 0; i < skin.positions.cols(); ++i)
-                    if (skin.positions(1, i) <= feet_top) {
+                    if (skin.positions(1, i) <= feet_top && skin.positions.col(i).allFinite()) {
                         const Eigen::Vector2f q(skin.positions(0, i), skin.positions(2, i));
                         feet_lo = feet_lo.cwiseMin(q);
                         feet_hi = feet_hi.cwiseMax(q);

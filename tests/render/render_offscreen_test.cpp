@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include "engine/core/scheduler.hpp"
@@ -284,6 +285,24 @@ TEST(RenderOffscreen, SkinnedPositionsNotMatchingTheMeshAreReported) {
     auto image = renderer->read_pixels();
     ASSERT_FALSE(image.has_value());
     EXPECT_NE(image.error().message.find("skinned positions"), std::string::npos) << image.error().message;
+}
+
+TEST(RenderOffscreen, NonFiniteParticlesNeitherCrashNorMoveTheCamera) {
+    auto renderer = make_renderer();
+    ASSERT_TRUE(renderer);
+    renderer->camera().follow = true;
+    Scene scene;
+    const Real nan = std::numeric_limits<Real>::quiet_NaN();
+    scene.registry.get<Garment>(scene.garment).x.col(5).setConstant(nan);
+    scene.registry.get<SkinnedMesh>(scene.body).positions.col(3).setConstant(nan);
+    update_follow_camera(renderer->camera(), scene.registry, 0);
+    EXPECT_TRUE(renderer->camera().target.allFinite()) << "one NaN vertex must not drag the camera away";
+    EXPECT_NEAR(renderer->camera().target.y(), 0.55f * 1.6f, 1e-4);
+    const Image image = render(*renderer, scene.registry);
+    ASSERT_FALSE(image.empty());
+    // The rest of the garment still draws in its colour.
+    const Rgb garment = pixel(image, *renderer->camera().project(Vec3(1.2f, 0.6f, 0.1f), width, height));
+    EXPECT_GT(garment.r, garment.g + 60);
 }
 
 TEST(RenderSystem, FollowsTheFirstCharacterAndRendersThroughTheScheduler) {
