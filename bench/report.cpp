@@ -119,8 +119,8 @@ Target upper_bound_target(std::string what, double measured, double bound, const
     } else if (t.met) {
         t.margin = fixed(100.0 * (1.0 - measured / bound), 0) + " % under";
     } else {
-        t.margin = "missed by " + fixed(measured - bound, decimals) + (unit.empty() ? "" : " " + unit) +
-                   " (" + fixed(measured / bound, 2) + "x the target)";
+        t.margin = "missed by " + fixed(measured - bound, decimals) + (unit.empty() ? "" : " " + unit);
+        if (bound > 0) t.margin += " (" + fixed(measured / bound, 2) + "x the target)";
     }
     return t;
 }
