@@ -173,8 +173,9 @@ struct Garment {
     std::vector<std::uint64_t> candidates;   ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
     std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep.
     bool lists_valid = false;                ///< False: rebuild the candidate lists before the next test.
-    Matrix3X list_anchor_x;                  ///< Particle positions (anchor frame) when the lists were built.
-    std::vector<Affine3> list_anchor_frames; ///< Unit sphere -> anchor frame of each collider then.
+    Matrix3X list_anchor_x;                  ///< Particle positions (anchor frame) when each list was built.
+    std::vector<Real> list_epoch_move;       ///< Per particle: ellipsoid displacement since the epoch when its list was built.
+    std::vector<Affine3> list_anchor_frames; ///< Unit sphere -> anchor frame of each collider at the epoch (last full build).
 
     GarmentCounters counters;
 

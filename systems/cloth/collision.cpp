@@ -237,7 +237,7 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
         const Vec3 anchor_origin = anchor.translation();
         const Real margin = g.material.candidate_margin_m;
         bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
-                     g.candidates.size() == static_cast<std::size_t>(n);
+                     g.candidates.size() == static_cast<std::size_t>(n) && g.list_epoch_move.size() == static_cast<std::size_t>(n);
         Real frame_move = 0;
         for (std::size_t e = 0; valid && e < e_count; ++e) {
             const Affine3& then = g.list_anchor_frames[e];
@@ -249,24 +249,13 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
             const Mat3 l = to_anchor * world.linear();
             frame_move = std::max(frame_move, (c - then.translation()).norm() + (l - then.linear()).norm());
         }
-        if (valid && frame_move > margin) valid = false;
-        Real particle_move_sq = 0;
-        if (valid) {
-            const Real budget_sq = (margin - frame_move) * (margin - frame_move);
-            for (Eigen::Index p = 0; p < n; ++p) {
-                const Real d_sq = (to_anchor * (g.x.col(p) - anchor_origin) - g.list_anchor_x.col(p)).squaredNorm();
-                particle_move_sq = std::max(particle_move_sq, d_sq);
-                if (d_sq > budget_sq) {
-                    valid = false;
-                    break;
-                }
-            }
-        }
-        slack = valid ? margin - frame_move - std::sqrt(particle_move_sq) : margin;
+        // A global rebuild (new epoch) once the ellipsoids have used half the margin.
+        if (valid && frame_move > margin / 2) valid = false;
         if (!valid) {
             const std::uint64_t tests = build_candidate_lists(g.x, g.frames, margin, g.candidates, &g.force);
             g.list_anchor_x.resize(3, n);
             for (Eigen::Index p = 0; p < n; ++p) g.list_anchor_x.col(p) = to_anchor * (g.x.col(p) - anchor_origin);
+            g.list_epoch_move.assign(static_cast<std::size_t>(n), 0);
             g.list_anchor_frames.resize(e_count);
             for (std::size_t e = 0; e < e_count; ++e) {
                 Affine3& then = g.list_anchor_frames[e];
@@ -280,10 +269,39 @@ CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
                 then.translation() = to_anchor * (world.translation() - anchor_origin);
             }
             g.lists_valid = true;
+            frame_move = 0;
             ++g.counters.list_rebuilds;
             g.counters.list_rebuild_tests += tests;
             g.counters.frame_list_rebuild_tests += tests;
         }
+        // Per particle: its list, built when the ellipsoids had moved epoch_move since the
+        // epoch, stays exact while its own move + epoch_move + frame_move <= margin.
+        // A particle past that bound gets a fresh list on its own.
+        slack = margin;
+        std::uint64_t particle_tests = 0;
+        const std::uint64_t active = active_mask(g.frames);
+        const int active_count = std::popcount(active);
+        for (Eigen::Index p = 0; p < n; ++p) {
+            const std::size_t pi = static_cast<std::size_t>(p);
+            const Vec3 local = to_anchor * (g.x.col(p) - anchor_origin);
+            Real room = margin - frame_move - g.list_epoch_move[pi] - (local - g.list_anchor_x.col(p)).norm();
+            if (room < 0) {
+                std::uint64_t bits = 0;
+                for_each_bit(active, [&](int e) {
+                    const EllipsoidFrame& f = g.frames[static_cast<std::size_t>(e)];
+                    const Real reach = 1 + margin / f.radii_m.minCoeff();
+                    if (to_unit_sphere(f, g.x.col(p)).squaredNorm() <= reach * reach) bits |= std::uint64_t(1) << e;
+                });
+                g.candidates[pi] = bits;
+                g.list_anchor_x.col(p) = local;
+                g.list_epoch_move[pi] = frame_move;
+                particle_tests += static_cast<std::uint64_t>(active_count);
+                room = margin - 2 * frame_move;
+            }
+            slack = std::min(slack, room);
+        }
+        g.counters.list_rebuild_tests += particle_tests;
+        g.counters.frame_list_rebuild_tests += particle_tests;
         lists = &g.candidates;
     }
 
