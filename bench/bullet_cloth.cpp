@@ -158,12 +158,17 @@ Matrix3X BulletCloth::positions() const {
     return x;
 }
 
-double max_penetration_m(const Matrix3X& x, const std::vector<Affine3>& ellipsoids) {
+double max_penetration_m(const Matrix3X& x, const std::vector<Affine3>& ellipsoids,
+                         const std::vector<std::uint32_t>& skip) {
+    std::vector<bool> skipped(static_cast<std::size_t>(x.cols()), false);
+    for (auto i : skip)
+        if (i < skipped.size()) skipped[i] = true;
     double deepest = 0;
     for (const auto& world : ellipsoids) {
         const Affine3 inverse = world.inverse();
         const Vec3 centre = world.translation();
         for (Eigen::Index i = 0; i < x.cols(); ++i) {
+            if (skipped[static_cast<std::size_t>(i)]) continue;
             const Vec3 q = inverse * x.col(i);
             const Real r = q.norm();
             if (!std::isfinite(r)) return std::numeric_limits<double>::infinity();

@@ -66,7 +66,10 @@ private:
 /// Deepest penetration of any point into any ellipsoid, m: a point p inside the unit sphere
 /// after mapping into ellipsoid space (|q| < 1, q = world^-1 p) is |p - c| (1/|q| - 1) deep,
 /// measured along the line from the centre, as Drape's response moves it (method §5).
-[[nodiscard]] double max_penetration_m(const Matrix3X& x, const std::vector<Affine3>& ellipsoids);
+/// Particles listed in `skip` (sorted; e.g. the pinned ones, which sit on the skin and may
+/// lie inside a fitted ellipsoid) are not tested.
+[[nodiscard]] double max_penetration_m(const Matrix3X& x, const std::vector<Affine3>& ellipsoids,
+                                       const std::vector<std::uint32_t>& skip = {});
 
 /// Largest spring strain, length / rest - 1 (0 when no spring is stretched).
 [[nodiscard]] double max_strain(const Matrix3X& x, const std::vector<std::array<std::uint32_t, 2>>& springs,

@@ -308,7 +308,7 @@ Result<void> run_stability(const BenchOptions& options) {
     const std::string script =
         "set title 'Skirt, one substep per step, walking: where symplectic Euler diverges'\n"
         "set xlabel 'spring stiffness k (N/m)'\nset ylabel 'step h (ms)'\nset logscale xy\nset grid\nset key outside right\n"
-        "plot $stable using 1:2 with points pt 7 ps 1.5 lc rgb '#30a050' title 'stable', "
+        "plot $stable using 1:2 with points pt 7 ps 1.5 lc rgb '#30a050' title 'not diverged', "
         "$unstable using 1:2 with points pt 2 ps 2 lw 2 lc rgb '#c03020' title 'diverged', "
         "$simple using 1:2 smooth unique with lines lw 2 lc rgb '#3060c0' title 'h = 2 sqrt(m/k)', "
         "$cloth using 1:2 smooth unique with lines dt 2 lw 2 lc rgb '#202020' title 'cloth bound (Gershgorin)'\n";
