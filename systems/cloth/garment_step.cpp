@@ -14,8 +14,8 @@
 
 namespace drape {
 namespace {
-// Rounds of layer-2 Provot (weft then ordered warp) after the placement (method §4.2).
-constexpr int layer2_rounds = 2;
+// Symmetric Provot passes over the layer-2 warp springs after the placement (method §4.2).
+constexpr int layer2_passes = 4;
 }  // namespace
 
 void prepare_garment(Garment& g) {
@@ -96,18 +96,14 @@ void constrain_garment(Garment& g, const FrameContext& ctx) {
         // §4.2: layer 2 placed in its planes from layer 1, its bulge limited (weft.hpp).
         compute_layer1_normals(t, g.x, g.normals);
         place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, o.h_s, o.limit);
-        // §4.2 item 3: Provot between placed particles, each kept in its plane, layer 1 and
-        // the pins fixed: the weft segments symmetric, then the layer-2 warp with its
-        // ordered pass last, a few rounds so that both end near the limit.
+        // §4.2 item 3: Provot between placed particles on the layer-2 warp, symmetric passes,
+        // each particle kept in its plane, layer 1 and the pins fixed. (An ordered pass or a
+        // pass over the weft segments here makes the worst strain larger: docs/cloth.md.)
         StrainLimitOptions layer2 = o;
         layer2.plane_normal = &g.plane_normal;
-        layer2.iterations = 1;
-        for (int round = 0; round < layer2_rounds; ++round) {
-            layer2.ordered_pass = false;
-            limit_strain(t.weft, g.x, g.v, g.movable_weft, layer2);
-            layer2.ordered_pass = true;
-            limit_strain(t.warp2, g.x, g.v, g.movable_weft, layer2);
-        }
+        layer2.iterations = layer2_passes;
+        layer2.ordered_pass = false;
+        limit_strain(t.warp2, g.x, g.v, g.movable_weft, layer2);
     } else {
         StrainLimitOptions weft = o;
         weft.ordered_pass = false;
