@@ -111,7 +111,11 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
 }
 
 int play(const PlayOptions& o) {
-    // --- Checks that need no scene.
+    // --- Checks that need no scene. (CLI11's range checks let NaN through.)
+    if (!std::isfinite(o.fps) || o.fps < 1 || o.fps > 1000)
+        return report("--fps: must be a number in [1, 1000], got " + std::to_string(o.fps));
+    if (o.time_scale && (!std::isfinite(*o.time_scale) || *o.time_scale < 0 || *o.time_scale > 1000))
+        return report("--time-scale: must be a number in [0, 1000], got " + std::to_string(*o.time_scale));
     std::pair<int, int> size{1280, 720};
     if (!o.size.empty()) {
         auto s = parse_size(o.size);

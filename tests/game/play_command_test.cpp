@@ -62,6 +62,8 @@ TEST_F(PlayCommand, BadValuesGiveOneLineNamingTheOption) {
     const std::vector<Case> cases = {
         {"--size 12x5 --headless", "drape play: --size: each side must be in [16, 8192] pixels, got 12x5\n"},
         {"--size big", "drape play: --size: must be WIDTHxHEIGHT in pixels, e.g. 1280x720, got \"big\"\n"},
+        {"--headless --fps nan", "drape play: --fps: must be a number in [1, 1000], got nan\n"},
+        {"--headless --time-scale nan", "drape play: --time-scale: must be a number in [0, 1000], got nan\n"},
         {"--headless --out frames", "drape play: --headless: cannot be combined with --out (nothing is rendered)\n"},
         {"--headless --window", "drape play: --headless: cannot be combined with --window (nothing is rendered)\n"},
         {"--headless --character nothing.glb", "drape play: --character: no such file: nothing.glb\n"},
