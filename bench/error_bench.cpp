@@ -413,10 +413,7 @@ Result<void> run_error(const BenchOptions& options) {
         "$cb using 1:2 with points pt 11 lc rgb '#e09060' title 'classic + brute force', "
         "$front using 1:2 with steps lw 2 lc rgb '#202020' title 'Pareto front', "
         "$def using 1:2 with points pt 3 ps 3 lw 2 lc rgb '#10a010' title 'default (auto substeps)'\n";
-    if (auto ok = plot(options.out_dir, "error.png", data, script, 1000, 560); ok)
-        report.image("error.png", "Error against ms per frame with the Pareto front");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("error.png", "Error against ms per frame with the Pareto front", data, script, 1000, 560);
 
     report.heading("Analytic reference: a mass on a spring");
     report.paragraph(
@@ -444,10 +441,7 @@ Result<void> run_error(const BenchOptions& options) {
         "plot $o using 1:2 with linespoints pt 7 title 'period error, measured', "
         "$o using 1:3 with lines dt 2 title 'period error, symplectic Euler theory', "
         "$o using 1:4 with linespoints pt 5 title 'amplitude drift over 19 periods'\n";
-    if (auto ok = plot(options.out_dir, "error_oscillator.png", osc_data, osc_script); ok)
-        report.image("error_oscillator.png", "Oscillator period and amplitude error against step size");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("error_oscillator.png", "Oscillator period and amplitude error against step size", osc_data, osc_script);
 
     report.heading("Analytic reference: a chain against the catenary");
     report.paragraph(
@@ -465,10 +459,7 @@ Result<void> run_error(const BenchOptions& options) {
                   "mean strain (%)"},
                  chain);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench

@@ -361,15 +361,9 @@ Result<void> run_peers(const BenchOptions& options) {
         "set title 'max penetration (mm)'\nplot $pen using 1:2 with boxes lc rgb '#c04030'\n"
         "set title 'max strain (%)'\nplot $strain using 1:2 with boxes lc rgb '#30a050'\n"
         "unset multiplot\n";
-    if (auto ok = plot(options.out_dir, "peers.png", data, script, 1100, 420); ok)
-        report.image("peers.png", "Drape and Bullet: time, penetration, strain");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("peers.png", "Drape and Bullet: time, penetration, strain", data, script, 1100, 420);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench

@@ -117,15 +117,9 @@ Result<void> run_render(const BenchOptions& options) {
         "set grid ytics\nset yrange [0:*]\nset key top left\nset xtics ('skirt' 0, 'dress' 1)\n"
         "plot $r using 2 title 'render system' lc rgb '#3060c0', '' using 3 title 'draw' lc rgb '#60a0e0', "
         "'' using 4 title 'draw + readback' lc rgb '#c04030', '' using 5 title 'whole tick' lc rgb '#30a050'\n";
-    if (auto ok = plot(options.out_dir, "render.png", data, script); ok)
-        report.image("render.png", "Rendering ms per frame");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("render.png", "Rendering ms per frame", data, script);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench

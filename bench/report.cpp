@@ -240,4 +240,19 @@ Result<void> write_json(const std::filesystem::path& file, const nlohmann::json&
     return {};
 }
 
+void Report::plot(const std::string& png_name, const std::string& alt, const std::vector<PlotData>& data,
+                  const std::string& script, int width_px, int height_px) {
+    if (auto ok = bench::plot(m_options.out_dir, png_name, data, script, width_px, height_px); ok)
+        image(png_name, alt);
+    else
+        missing_plot(ok.error().message);
+}
+
+Result<void> finish(const Report& report, const BenchOptions& options, const nlohmann::json& json) {
+    if (auto path = report.write(); !path) return fail(path.error().message);
+    if (!options.json.empty())
+        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
+    return {};
+}
+
 }  // namespace drape::bench

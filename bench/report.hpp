@@ -67,6 +67,12 @@ struct Target {
 /// Formats a number with a fixed count of decimals ("-" for non-finite).
 [[nodiscard]] std::string fixed(double value, int decimals = 3);
 
+/// One data block of a plot: columns separated by spaces, one row per line.
+struct PlotData {
+    std::string name;                         ///< Referred to as "$name" in the script.
+    std::vector<std::vector<double>> rows;
+};
+
 /// A Markdown report, section by section.
 class Report {
 public:
@@ -80,6 +86,9 @@ public:
     void image(const std::string& png_name, const std::string& alt);
     /// Says that a plot could not be made (e.g. gnuplot absent) and why.
     void missing_plot(const std::string& why);
+    /// Renders a gnuplot plot into the output folder and adds it, or says why it could not.
+    void plot(const std::string& png_name, const std::string& alt, const std::vector<PlotData>& data,
+              const std::string& script, int width_px = 900, int height_px = 560);
 
     /// Writes `<out_dir>/<name>.md` (creating the folder); returns the path.
     [[nodiscard]] Result<std::filesystem::path> write() const;
@@ -90,11 +99,6 @@ private:
     Machine m_machine;
 };
 
-/// One data block of a plot: columns separated by spaces, one row per line.
-struct PlotData {
-    std::string name;                         ///< Referred to as "$name" in the script.
-    std::vector<std::vector<double>> rows;
-};
 
 /// Renders a gnuplot script to `<out_dir>/<png_name>` (pngcairo when available, png
 /// otherwise). Data blocks are inlined as gnuplot datablocks. Returns an error when gnuplot
@@ -105,6 +109,9 @@ struct PlotData {
 
 /// Writes JSON (indented) to a file; errors name the file.
 [[nodiscard]] Result<void> write_json(const std::filesystem::path& file, const nlohmann::json& value);
+
+/// The end of every benchmark: writes the report, and the JSON when --json was given.
+[[nodiscard]] Result<void> finish(const Report& report, const BenchOptions& options, const nlohmann::json& json);
 
 /// A registered benchmark.
 struct Benchmark {

@@ -179,15 +179,9 @@ Result<void> run_scale(const BenchOptions& options) {
         "$walk1 using 1:4 with lines dt 3 lc rgb '#3060c0' title 'garments, 1 thread', "
         "16.667 with lines lc rgb '#30a050' title '60 fps'\n"
         "unset multiplot\n";
-    if (auto ok = plot(options.out_dir, "scale.png", data, script, 1200, 500); ok)
-        report.image("scale.png", "Cost per particle against garment size; frame time against walkers");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("scale.png", "Cost per particle against garment size; frame time against walkers", data, script, 1200, 500);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench

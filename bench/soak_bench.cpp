@@ -229,10 +229,7 @@ Result<void> run_soak(const BenchOptions& options) {
                   "peak energy (mJ)", "non-finite", "resets", "teleports", "wall (s)"},
                  rows);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench

@@ -312,10 +312,7 @@ Result<void> run_stability(const BenchOptions& options) {
         "$unstable using 1:2 with points pt 2 ps 2 lw 2 lc rgb '#c03020' title 'diverged', "
         "$simple using 1:2 smooth unique with lines lw 2 lc rgb '#3060c0' title 'h = 2 sqrt(m/k)', "
         "$cloth using 1:2 smooth unique with lines dt 2 lw 2 lc rgb '#202020' title 'cloth bound (Gershgorin)'\n";
-    if (auto ok = plot(options.out_dir, "stability.png", data, script, 1000, 560); ok)
-        report.image("stability.png", "Stability map: step against stiffness");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("stability.png", "Stability map: step against stiffness", data, script, 1000, 560);
 
     report.heading("Unstable cases with automatic substeps");
     std::vector<std::vector<std::string>> unstable_rows;
@@ -327,10 +324,7 @@ Result<void> run_stability(const BenchOptions& options) {
     else
         report.table({"case", "substeps / step", "max strain (%)", "reason"}, unstable_rows);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench

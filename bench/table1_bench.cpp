@@ -177,15 +177,9 @@ Result<void> run_table1(const BenchOptions& options) {
         "set ylabel 'ms per frame'\nset grid ytics\nset yrange [0:*]\nset key top right\n"
         "set xtics ('integrate' 0, 'collide' 1, 'garment total' 2)\n"
         "plot $t using 2 title 'classic + brute force' lc rgb '#c04030', '' using 3 title 'simplified + lists' lc rgb '#3060c0'\n";
-    if (auto ok = plot(options.out_dir, "table1.png", data, script); ok)
-        report.image("table1.png", "Table 1: integrate, collide and total ms per frame");
-    else
-        report.missing_plot(ok.error().message);
+    report.plot("table1.png", "Table 1: integrate, collide and total ms per frame", data, script);
 
-    if (auto path = report.write(); !path) return fail(path.error().message);
-    if (!options.json.empty())
-        if (auto ok = write_json(options.json, json); !ok) return fail(ok.error().message);
-    return {};
+    return finish(report, options, json);
 }
 
 }  // namespace drape::bench
