@@ -7,6 +7,7 @@
 // Off-screen rendering goes through Mesa; on a machine without a GPU that is llvmpipe,
 // which rasterises on the CPU cores the simulation also uses.
 #include <algorithm>
+#include <chrono>
 
 #include "bench/probe.hpp"
 #include "bench/report.hpp"
@@ -54,11 +55,17 @@ Result<void> run_render(const BenchOptions& options) {
                 if (auto ok = step_world(*world, frame_dt_s); !ok) return fail("render: " + ok.error().message);
             const auto& profiler = world->scheduler.profiler();
             const double render_before = profiler.stats("render").total_ms;
-            const double frames_before = profiler.mean_frame_ms() * static_cast<double>(profiler.frames());
-            for (int f = 0; f < timed_frames; ++f)
+            // A tick is only done when its frame is: GL queues the draw, and llvmpipe rasterises it
+            // on the same cores afterwards, so each timed tick waits for the frame to finish.
+            std::vector<double> ticks_ms;
+            for (int f = 0; f < timed_frames; ++f) {
+                const auto start = std::chrono::steady_clock::now();
                 if (auto ok = step_world(*world, frame_dt_s); !ok) return fail("render: " + ok.error().message);
+                world->renderer->finish();
+                ticks_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+            }
             system.push_back((profiler.stats("render").total_ms - render_before) / timed_frames);
-            frame.push_back((profiler.mean_frame_ms() * static_cast<double>(profiler.frames()) - frames_before) / timed_frames);
+            frame.push_back(median(ticks_ms));
             auto no_readback = time_render_frames(*world->renderer, world->registry, timed_frames, false);
             if (!no_readback) return fail("render: " + no_readback.error().message);
             auto with_readback = time_render_frames(*world->renderer, world->registry, timed_frames, true);
@@ -90,8 +97,8 @@ Result<void> run_render(const BenchOptions& options) {
     report.paragraph(
         "Renderer: " + renderer_text + ". Each run builds the scene with an off-screen 1280x720 renderer, simulates " +
         std::to_string(settle_frames) + " frames, then times " + std::to_string(timed_frames) + " ticks with the "
-        "render system in the schedule (render system time from the frame profiler; whole tick = simulation + "
-        "rendering), and " + std::to_string(timed_frames) + " redraws of the same state through the render "
+        "render system in the schedule (render system time from the frame profiler, which stops when the draw "
+        "calls are queued; whole tick = wall time of simulation + rendering until the frame is finished), and " + std::to_string(timed_frames) + " redraws of the same state through the render "
         "system's path (time_render_frames: camera follow, draw, resolve, wait until the frame is finished) without "
         "and with reading the pixels back. Figures are medians over frames, then over runs. On a machine without a "
         "GPU, Mesa's llvmpipe rasterises on the same CPU cores the simulation uses.");
@@ -103,9 +110,11 @@ Result<void> run_render(const BenchOptions& options) {
                  table);
     report.heading("Frame budget");
     std::vector<Target> targets;
-    for (const auto& r : rows)
-        targets.push_back(upper_bound_target(r.scene + ": whole tick with rendering (60 fps)", r.frame_ms, 1000.0 / 60.0, "ms", 2));
-    report.paragraph("No rendering target is set for Drape; the 60 fps budget is shown for reference.");
+    // The sample scene is the skirt; the dress row is there to show how the cost grows.
+    targets.push_back(upper_bound_target(rows.front().scene + ": whole tick with rendering (60 fps)", rows.front().frame_ms,
+                                         1000.0 / 60.0, "ms", 2));
+    report.paragraph("Target: the sample scene (the skirt) at 60 fps or better, i.e. the whole tick, waiting for the "
+                     "frame to be finished, within 16.67 ms. The dress is shown for reference.");
     report.targets(targets);
 
     std::vector<PlotData> data{{"r", {}}};
