@@ -29,6 +29,10 @@ Result<void> validate_grid(std::string_view p, int lines, int per_line, int stri
     if (lines < 2 || lines > 4096) return fail(field(p, "warp_lines") + ": must be in [2, 4096], got " + std::to_string(lines));
     if (per_line < 2 || per_line > 4096)
         return fail(field(p, "particles_per_line") + ": must be in [2, 4096], got " + std::to_string(per_line));
+    if (static_cast<long long>(lines) * per_line > max_garment_particles)
+        return fail(field(p, "warp_lines") + " x " + field(p, "particles_per_line") + ": must be at most " +
+                    std::to_string(max_garment_particles) + " particles, got " + std::to_string(lines) + " x " +
+                    std::to_string(per_line) + " = " + std::to_string(static_cast<long long>(lines) * per_line));
     if (stride < 1 || stride >= lines)
         return fail(field(p, "weft_stride") + ": must be in [1, warp_lines), got " + std::to_string(stride));
     if (closed && lines % stride != 0)
