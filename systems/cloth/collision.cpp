@@ -2,9 +2,11 @@
 #include "systems/cloth/collision.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "systems/cloth/body.hpp"
 
@@ -32,6 +34,26 @@ inline Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     return static_cast<Real>((-b + std::sqrt(disc)) / (2 * a));
 }
 
+// The response of one contact (method §5): onto the surface along the centre line, or
+// along the outward normal at the particle when that way out is shorter. Deep inside an
+// elongated ellipsoid (a thigh the hem swung into) the centre line runs along the long axis
+// and would carry the particle tens of centimetres toward the knee; the normal leaves by
+// the short side. Near the surface both agree.
+inline void respond_shortest(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
+    const Real y_length = y.norm();
+    if (y_length > Real(1e-6)) {
+        const Vec3 normal = (f.to_unit.transpose() * y).normalized();
+        const Real along_normal = ray_exit(f, x, normal);
+        const Real along_centre = (x - f.center).norm() * (1 / y_length - 1);
+        if (along_normal >= 0 && along_normal < along_centre) {
+            // push_out only rescales this point's unit-sphere image onto the surface (+ clearance).
+            push_out(f, to_unit_sphere(f, x + along_normal * normal), x, v);
+            return;
+        }
+    }
+    push_out(f, y, x, v);
+}
+
 template <class F>
 inline void for_each_bit(std::uint64_t bits, F&& f) {
     while (bits != 0) {
@@ -39,6 +61,83 @@ inline void for_each_bit(std::uint64_t bits, F&& f) {
         bits &= bits - 1;
         f(e);
     }
+}
+
+// Entry and exit distances of the ray o + t d (|d| = 1) through the ellipsoid; in > out if it misses.
+inline std::pair<Real, Real> ray_span(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
+    const Eigen::Vector3d oo = to_unit_sphere(f, o).cast<double>();
+    const Eigen::Vector3d dd = (f.to_unit * d).cast<double>();
+    const double a = dd.squaredNorm(), b = 2 * oo.dot(dd), c = oo.squaredNorm() - 1;
+    const double disc = b * b - 4 * a * c;
+    if (disc < 0 || a <= 0) return {1, 0};
+    const double root = std::sqrt(disc);
+    return {static_cast<Real>((-b - root) / (2 * a)), static_cast<Real>((-b + root) / (2 * a))};
+}
+
+// Smallest t >= 0 at which o + t d is outside every ellipsoid of `set`. Each is convex, so the
+// ray is inside it on one interval: step past every interval that covers t until none does
+// (each interval is passed at most once). Stops early once t exceeds `give_up`.
+inline Real first_point_outside(std::span<const EllipsoidFrame> frames, std::uint64_t set, const Vec3& o,
+                                const Vec3& d, Real give_up) {
+    Real t = 0;
+    for (int pass = 0; pass <= 64 && t <= give_up; ++pass) {
+        bool advanced = false;
+        for_each_bit(set, [&](int e) {
+            const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+            const auto [in, out] = ray_span(f, o, d);
+            if (in <= t && t < out) {
+                t = out + 2 * surface_clearance(f) * f.radii_m.maxCoeff();
+                advanced = true;
+            }
+        });
+        if (!advanced) break;
+    }
+    return t;
+}
+
+// Way out for a particle the re-test rounds could not free: from `x` (where it was detected),
+// along the shortest of the outward normals and centre lines of the ellipsoids it was found
+// in, their bisector and crease (the first two), the direction the rounds moved it and the
+// direction back to where it started the substep, to the first point outside every active
+// ellipsoid. Never carried past an ellipsoid it could stop before, unlike a single ray from a
+// centre (which, through overlapping thigh and shin, ran out past the foot).
+inline Vec3 fallback_exit(std::span<const EllipsoidFrame> frames, std::uint64_t active, const Vec3& x,
+                          std::uint64_t hits, const Vec3& after_rounds, const Vec3& start) {
+    std::array<Vec3, 10> ways;
+    std::size_t count = 0;
+    const auto add = [&](const Vec3& d) {
+        const Real length = d.norm();
+        if (length > Real(1e-9) && count < ways.size()) ways[count++] = d / length;
+    };
+    std::array<Vec3, 2> normals{Vec3::Zero(), Vec3::Zero()};
+    std::size_t found = 0;
+    for_each_bit(hits, [&](int e) {
+        const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+        const Vec3 n = f.to_unit.transpose() * to_unit_sphere(f, x);
+        if (found < normals.size()) normals[found++] = n.normalized();
+        if (count + 2 <= 6) {
+            add(n);
+            add(x - f.center);
+        }
+    });
+    if (found == 2) {
+        add(normals[0] + normals[1]);
+        add(normals[0].cross(normals[1]));
+        add(normals[1].cross(normals[0]));
+    }
+    add(after_rounds - x);
+    add(start - x);
+    if (count == 0) ways[count++] = Vec3::UnitY();
+    Real best = std::numeric_limits<Real>::infinity();
+    Vec3 out = x;
+    for (std::size_t k = 0; k < count; ++k) {
+        const Real t = first_point_outside(frames, active, x, ways[k], best);
+        if (t < best) {
+            best = t;
+            out = x + t * ways[k];
+        }
+    }
+    return out;
 }
 
 }  // namespace
@@ -147,7 +246,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
             const Vec3 y = to_unit_sphere(f, xp);
             if (y.squaredNorm() >= 1) return false;
-            push_out(f, y, xp, vp);
+            respond_shortest(f, y, xp, vp);
             ++r.collisions;
             return true;
         };
@@ -167,31 +266,13 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                 });
             }
             if (moved) {
-                // Still between overlapping ellipsoids: leave along the centre line of the
-                // last one hit, past every ellipsoid of the list that line crosses. Each is
-                // convex, so beyond its exit point the line stays outside it.
-                const EllipsoidFrame& f = frames[static_cast<std::size_t>(std::countr_zero(hits))];
-                Vec3 d = xp - f.center;
-                const Real length = d.norm();
-                d = length > Real(1e-9) ? Vec3(d / length) : Vec3(f.rotation.col(0));
-                Real exit = 0;
-                for_each_bit(retest, [&](int e) {
-                    const EllipsoidFrame& g = frames[static_cast<std::size_t>(e)];
-                    const Real t = ray_exit(g, f.center, d);
-                    exit = std::max(exit, t + 2 * surface_clearance(g) * g.radii_m.maxCoeff());
-                });
-                xp = f.center + d * exit;
-                if ((xp - x_detected).squaredNorm() > slack_sq && retest != active) {
-                    retest = active;  // the exit went beyond the list's reach: once more against all
-                    exit = 0;
-                    for_each_bit(retest, [&](int e) {
-                        const EllipsoidFrame& g = frames[static_cast<std::size_t>(e)];
-                        exit = std::max(exit, ray_exit(g, f.center, d) + 2 * surface_clearance(g) * g.radii_m.maxCoeff());
-                    });
-                    xp = f.center + d * exit;
-                }
+                // Still between overlapping ellipsoids (a crease, the thighs where they meet):
+                // leave from where it was detected by the shortest of a few straight ways out,
+                // past every ellipsoid the way crosses (fallback_exit).
+                xp = fallback_exit(frames, active, x_detected, hits, xp,
+                                   x_start != nullptr ? Vec3(x_start->col(p)) : x_detected);
                 Real depth = 0;
-                for_each_bit(retest, [&](int e) {
+                for_each_bit(active, [&](int e) {
                     ++r.tests;
                     depth = std::max(depth, penetration_depth(frames[static_cast<std::size_t>(e)], xp));
                 });

@@ -16,9 +16,12 @@
 //   3. Response for each hit, last-collided first: move the particle to where the line
 //      from the centre through it meets the surface, x = c + (x - c) / |y|, and remove the
 //      velocity component along the surface normal relative to the surface's own motion
-//      (the ellipsoid is inelastic). Overlapping ellipsoids can push a particle into a
-//      neighbour, so the particle's list is re-tested until it is outside all of them
-//      (every ellipsoid, when the push went beyond what the list bound still covers).
+//      (the ellipsoid is inelastic); when the surface is nearer along the outward normal
+//      at the particle (deep in an elongated ellipsoid), along that normal instead.
+//      Overlapping ellipsoids can push a particle into a neighbour, so the particle's list
+//      is re-tested until it is outside all of them (every ellipsoid, when the push went
+//      beyond what the list bound still covers); after a few rounds it leaves from where it
+//      was detected by the shortest of a few straight ways out past every ellipsoid.
 //      Within a substep, a particle that collided takes the velocity of its whole move,
 //      (x_end - x_start) / h, before the normal component is removed: the constraints
 //      and the push-out then cannot pump energy into a particle held against the body.
