@@ -37,6 +37,7 @@ void add_inspect_command(CLI::App& app) {
             command_exit_code() = 1;
             return;
         }
+        for (const std::string& warning : (*character)->warnings) std::fprintf(stderr, "drape inspect: warning: %s\n", warning.c_str());
         const CoverageReport coverage = rest_pose_coverage(**character);
         const std::string report = o->json ? character_report_json(**character, coverage)
                                            : character_report_text(**character, coverage);

@@ -48,6 +48,9 @@ struct CharacterAsset {
     ScaleSource scale_source = ScaleSource::file_units;
     int skin_bones = 0;                                 ///< Bones that move at least one vertex.
     int hip_bone = -1;                                  ///< find_hip_bone(); -1 when none.
+    /// What the import accepted but a user may want to know (e.g. zero-length end bones
+    /// without weights): one line each, naming the file.
+    std::vector<std::string> warnings;
 };
 
 }  // namespace drape

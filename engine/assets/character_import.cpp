@@ -18,6 +18,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include <Eigen/SVD>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/material.h>
@@ -59,6 +60,15 @@ Affine3 to_affine(const aiMatrix4x4& m) {
 }
 
 bool finite(const Affine3& a) { return a.matrix().allFinite(); }
+
+// An inverse bind matrix skinning can use: finite and invertible. Judged by the ratio of
+// its smallest to largest singular value, so the file's units do not matter; a bone
+// scaled to zero at bind (or flattened onto a plane) has a ratio of about 0.
+bool usable_bind(const Affine3& a) {
+    if (!finite(a)) return false;
+    const Vec3 s = Eigen::JacobiSVD<Mat3>(a.linear()).singularValues();
+    return s(0) > 0 && s(2) > Real(1e-6) * s(0);
+}
 
 aiMatrix4x4 node_global(const aiNode* node) {
     aiMatrix4x4 m = node->mTransformation;
@@ -115,6 +125,7 @@ struct Builder {
     std::unordered_map<const aiNode*, int> bone_of_node;
     std::vector<Affine3> rest_global;
     std::vector<bool> has_bind;  // inverse_bind came from a skin (else: the node pose)
+    std::vector<std::string> warnings;
 
     [[nodiscard]] std::string at() const { return where(path); }
 
@@ -221,7 +232,7 @@ void collect_inverse_binds(Builder& b) {
             const int bone = b.bone_of_node.at(node);
             if (b.has_bind[static_cast<std::size_t>(bone)]) continue;
             const Affine3 offset = to_affine(mesh->mBones[i]->mOffsetMatrix);
-            if (!finite(offset) || std::abs(offset.linear().determinant()) < 1e-20f) continue;
+            if (!usable_bind(offset)) continue;  // build_mesh names the bone (an error when it has weights)
             b.skeleton.inverse_bind[static_cast<std::size_t>(bone)] = offset * g->second.inverse();
             b.has_bind[static_cast<std::size_t>(bone)] = true;
         }
@@ -274,6 +285,20 @@ Result<void> build_mesh(Builder& b, MeshAsset& out, std::vector<MeshInfo>& infos
             const int index = b.bone_of_node.at(scene->mRootNode->FindNode(bone->mName));
             offsets[i] = to_affine(bone->mOffsetMatrix);
             offset_bone[i] = index;
+            if (!usable_bind(offsets[i])) {
+                // Skinning maps a vertex through the inverse of this matrix: with weights on the
+                // bone its vertices would collapse (zero scale) or go non-finite. Without weights
+                // the bone only moves its children (exporters write such end bones).
+                const std::string why = std::string(finite(offsets[i]) ? "singular (zero scale)" : "non-finite") +
+                                        " inverse bind matrix";
+                const auto weighted = std::count_if(bone->mWeights, bone->mWeights + bone->mNumWeights,
+                                                    [](const aiVertexWeight& w) { return w.mWeight > 0; });
+                if (weighted > 0)
+                    return fail(b.at() + ": mesh '" + mesh_name + "': bone '" + bone->mName.C_Str() + "' has a " + why +
+                                " but " + std::to_string(weighted) + " vertices are skinned to it");
+                b.warnings.push_back(b.at() + ": mesh '" + mesh_name + "': bone '" + bone->mName.C_Str() + "' has a " + why +
+                                     " and no skinned vertices, ignored");
+            }
             for (unsigned w = 0; w < bone->mNumWeights; ++w) {
                 const aiVertexWeight& vw = bone->mWeights[w];
                 if (!std::isfinite(vw.mWeight) || vw.mWeight < 0)
@@ -434,6 +459,67 @@ void apply_root_correction(SkeletonAsset& skeleton, MeshAsset& mesh, std::vector
         }
 }
 
+// Zero-length bones in the rest (node) pose: a bone whose child joints all sit at its own
+// joint, or an end bone (no children) at its parent joint's place. Such a bone has no
+// direction, and when a whole chain is like that the rest pose folds the body up (a file
+// whose joints were all moved onto their parents plays a 1.75 m avatar 0.58 m tall): with
+// vertices skinned to it, an error. Without, it is an exporter's end marker (a leaf joint
+// at its parent's place): a warning, and it does not make its parent zero-length.
+// Lengths are compared with the bind mesh's size, so the file's units do not matter.
+Result<void> check_bone_lengths(Builder& b, const MeshAsset& mesh) {
+    const SkeletonAsset& s = b.skeleton;
+    const std::size_t bones = s.size();
+    std::vector<int> weighted(bones, 0);
+    for (Eigen::Index j = 0; j < mesh.bone_weights.cols(); ++j)
+        for (int k = 0; k < 4; ++k)
+            if (mesh.bone_weights(k, j) > 0) ++weighted[static_cast<std::size_t>(mesh.bone_indices(k, j))];
+    const Real size = (mesh.bind_positions.rowwise().maxCoeff() - mesh.bind_positions.rowwise().minCoeff()).norm();
+    const Real zero = Real(1e-4) * size;
+    std::vector<bool> has_children(bones, false);
+    for (std::size_t i = 0; i < bones; ++i)
+        if (s.parents[i] >= 0) has_children[static_cast<std::size_t>(s.parents[i])] = true;
+    auto to_parent = [&](std::size_t i) {
+        return (b.rest_global[i].translation() - b.rest_global[static_cast<std::size_t>(s.parents[i])].translation()).norm();
+    };
+    // An end marker: a leaf joint without vertices at its parent joint's place.
+    auto end_marker = [&](std::size_t i) {
+        return !has_children[i] && weighted[i] == 0 && s.parents[i] >= 0 && to_parent(i) <= zero;
+    };
+    std::vector<Real> length(bones, -1);  // -1: unknown (no informative child, no parent joint)
+    for (std::size_t i = 0; i < bones; ++i) {
+        if (s.parents[i] < 0 || end_marker(i)) continue;
+        Real& l = length[static_cast<std::size_t>(s.parents[i])];
+        l = std::max(l, to_parent(i));
+    }
+    std::string markers;
+    int marker_count = 0;
+    for (std::size_t i = 0; i < bones; ++i) {
+        if (end_marker(i)) {
+            if (b.has_bind[i] && ++marker_count <= 5) markers += (markers.empty() ? "'" : ", '") + s.bone_names[i] + "'";
+            continue;
+        }
+        if (weighted[i] == 0) continue;
+        bool end_bone = false;
+        if (length[i] < 0) {  // no child joint that tells its length: the segment from its parent joint
+            const int parent = s.parents[i];
+            if (parent < 0 || !b.has_bind[static_cast<std::size_t>(parent)]) continue;  // hangs from a scene node
+            length[i] = to_parent(i);
+            end_bone = true;
+        }
+        if (length[i] > zero) continue;
+        const std::string what = end_bone ? "an end bone at the joint of its parent '" +
+                                                s.bone_names[static_cast<std::size_t>(s.parents[i])] + "'"
+                                          : "its child joints sit at its own joint";
+        return fail(b.at() + ": bone '" + s.bone_names[i] + "' has zero length in the rest pose (" + what + ") but " +
+                    std::to_string(weighted[i]) + " vertices are skinned to it");
+    }
+    if (marker_count > 0)
+        b.warnings.push_back(b.at() + ": " + std::to_string(marker_count) + " zero-length end bone" +
+                             (marker_count > 1 ? "s" : "") + " without skinned vertices, ignored: " + markers +
+                             (marker_count > 5 ? ", ..." : ""));
+    return {};
+}
+
 Real rest_height(const SkeletonAsset& skeleton, const MeshAsset& mesh) {
     std::vector<Affine3> global, skinning;
     compose_pose(skeleton, skeleton.rest_local, global);
@@ -521,6 +607,7 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     auto mesh = std::make_shared<MeshAsset>();
     auto asset = std::make_shared<CharacterAsset>();
     if (auto ok = build_mesh(b, *mesh, asset->meshes); !ok) return std::unexpected(ok.error());
+    if (auto ok = check_bone_lengths(b, *mesh); !ok) return std::unexpected(ok.error());
 
     std::vector<std::shared_ptr<AnimationClip>> clips;
     for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
@@ -580,6 +667,7 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     asset->scale_source = source;
     asset->height_m = rest_height(skeleton, *mesh);
     asset->skin_bones = static_cast<int>(std::count(moves.begin(), moves.end(), true));
+    asset->warnings = std::move(b.warnings);
     auto shared_skeleton = std::make_shared<const SkeletonAsset>(std::move(skeleton));
     asset->skeleton = shared_skeleton;
     asset->hip_bone = find_hip_bone(*shared_skeleton);

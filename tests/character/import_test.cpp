@@ -127,5 +127,59 @@ TEST(CharacterImport, OptionsAreValidatedWithTheFieldName) {
     EXPECT_NE(validate(bad).error().message.find("fit.cluster_coverage"), std::string::npos);
 }
 
+// Bones skinning or fitting cannot use are errors naming the file and the bone; unweighted
+// end bones of the same kinds (common in exported rigs) load with a warning.
+class BoneCheck : public ::testing::Test {
+protected:
+    void SetUp() override { m_dir = test::temp_dir("bones"); }
+    void TearDown() override { std::filesystem::remove_all(m_dir); }
+    Result<std::shared_ptr<const CharacterAsset>> import(const test::TestCharacter& spec) {
+        write_test_character(spec, m_dir / "column.gltf");
+        return import_character(m_dir / "column.gltf");
+    }
+    std::string file() const { return (m_dir / "column.gltf").string(); }
+    std::filesystem::path m_dir;
+};
+
+TEST_F(BoneCheck, ZeroLengthBoneWithSkinnedVerticesIsAnError) {
+    // Child's joint moved onto Root's: Root has no direction, and rings 0 to 2 (24 vertices)
+    // are skinned to it.
+    auto r = import({.child_offset_m = 0});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message, file() + ": bone 'Root' has zero length in the rest pose (its child joints sit at its own "
+                                          "joint) but 24 vertices are skinned to it");
+}
+
+TEST_F(BoneCheck, ZeroScaleBindMatrixWithSkinnedVerticesIsAnError) {
+    auto r = import({.zero_scale_child_bind = true});
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message,
+              file() + ": mesh 'Column': bone 'Child' has a singular (zero scale) inverse bind matrix but 24 vertices are skinned to it");
+}
+
+TEST_F(BoneCheck, UnweightedZeroLengthEndBoneLoadsWithAWarning) {
+    auto r = import({.end_bone_offset_m = 0});
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ((*r)->warnings.size(), 1u);
+    EXPECT_EQ((*r)->warnings[0], file() + ": 1 zero-length end bone without skinned vertices, ignored: 'ChildEnd'");
+    EXPECT_TRUE((*r)->mesh->bind_positions.allFinite());
+    for (const EllipsoidShape& e : (*r)->ellipsoids) EXPECT_TRUE(e.radii_m.allFinite() && e.radii_m.minCoeff() > 0);
+}
+
+TEST_F(BoneCheck, UnweightedEndBoneWithAZeroScaleBindLoadsWithAWarning) {
+    auto r = import({.end_bone_offset_m = 0.3f, .zero_scale_end_bind = true});
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ((*r)->warnings.size(), 1u);
+    EXPECT_EQ((*r)->warnings[0],
+              file() + ": mesh 'Column': bone 'ChildEnd' has a singular (zero scale) inverse bind matrix and no skinned vertices, ignored");
+    EXPECT_TRUE((*r)->mesh->bind_positions.allFinite());
+}
+
+TEST_F(BoneCheck, EndBoneWithALengthGivesNoWarning) {
+    auto r = import({.end_bone_offset_m = 0.3f});
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_TRUE((*r)->warnings.empty()) << (*r)->warnings.front();
+}
+
 }  // namespace
 }  // namespace drape

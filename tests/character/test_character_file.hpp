@@ -4,6 +4,7 @@
 // must reject. Files go to a fresh temporary directory, never into the project.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -27,6 +28,10 @@ struct TestCharacter {
     int rings = 5;                    ///< Vertex rings from y = 0 to y = 2.
     int ring_vertices = 8;
     float radius_m = 0.2f;
+    float child_offset_m = 1;         ///< Child's joint above Root's in the node (rest) pose; 0: a zero-length Root.
+    bool zero_scale_child_bind = false;  ///< Child's inverse bind matrix scaled to zero.
+    float end_bone_offset_m = -1;     ///< >= 0: an unweighted joint "ChildEnd" this far above Child (0: zero length).
+    bool zero_scale_end_bind = false; ///< ChildEnd's inverse bind matrix scaled to zero.
 };
 
 /// A fresh temporary directory for one test.
@@ -94,7 +99,13 @@ inline void write_test_character(const TestCharacter& c, const std::filesystem::
             indices.insert(indices.end(), {a, a2, b, b, a2, b2});
         }
     // Inverse binds: Root at the origin, Child at y = 1 (straight bind pose), column-major.
-    const float ibm[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    if (c.zero_scale_child_bind) std::fill(ibm.begin() + 16, ibm.begin() + 32, 0.0f);
+    const bool end_bone = c.end_bone_offset_m >= 0;
+    if (end_bone) {
+        ibm.insert(ibm.end(), {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1 - c.end_bone_offset_m, 0, 1});
+        if (c.zero_scale_end_bind) std::fill(ibm.end() - 16, ibm.end(), 0.0f);
+    }
     const float times[3] = {0, 0.5f, 1};
     const float s45 = std::sin(float(M_PI) / 8), c45 = std::cos(float(M_PI) / 8);
     float rotations[12] = {0, 0, 0, 1, 0, 0, s45, c45, 0, 0, std::sin(float(M_PI) / 4), std::cos(float(M_PI) / 4)};
@@ -105,17 +116,20 @@ inline void write_test_character(const TestCharacter& c, const std::filesystem::
     const auto v_joint = append(joints.data(), joints.size());
     const auto v_weight = append(weights.data(), weights.size() * 4);
     const auto v_index = append(indices.data(), indices.size() * 2);
-    const auto v_ibm = append(ibm, sizeof ibm);
+    const auto v_ibm = append(ibm.data(), ibm.size() * 4);
     const auto v_time = append(times, sizeof times);
     const auto v_rot = append(rotations, sizeof rotations);
     const auto v_tr = append(translations, sizeof translations);
 
     std::string j = "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,2]}],";
     const float ra = c.child_rest_angle_rad / 2;
-    j += "\"nodes\":[{\"name\":\"Root\",\"children\":[1]},{\"name\":\"Child\",\"translation\":[0,1,0],\"rotation\":[0,0," +
-         std::to_string(std::sin(ra)) + "," + std::to_string(std::cos(ra)) + "]},";
-    j += std::string("{\"name\":\"Body\",\"mesh\":0") + (c.skin ? ",\"skin\":0" : "") + "}],";
-    if (c.skin) j += "\"skins\":[{\"joints\":[0,1],\"inverseBindMatrices\":4}],";
+    j += "\"nodes\":[{\"name\":\"Root\",\"children\":[1]},{\"name\":\"Child\",\"translation\":[0," +
+         std::to_string(c.child_offset_m) + ",0],\"rotation\":[0,0," + std::to_string(std::sin(ra)) + "," +
+         std::to_string(std::cos(ra)) + "]" + (end_bone ? ",\"children\":[3]" : "") + "},";
+    j += std::string("{\"name\":\"Body\",\"mesh\":0") + (c.skin ? ",\"skin\":0" : "") + "}";
+    if (end_bone) j += ",{\"name\":\"ChildEnd\",\"translation\":[0," + std::to_string(c.end_bone_offset_m) + ",0]}";
+    j += "],";
+    if (c.skin) j += std::string("\"skins\":[{\"joints\":[0,1") + (end_bone ? ",3" : "") + "],\"inverseBindMatrices\":4}],";
     j += "\"meshes\":[{\"name\":\"Column\",\"primitives\":[{\"attributes\":{\"POSITION\":0";
     if (c.skin) j += ",\"JOINTS_0\":1,\"WEIGHTS_0\":2";
     j += "},\"indices\":3}]}],";
@@ -131,14 +145,17 @@ inline void write_test_character(const TestCharacter& c, const std::filesystem::
          "{\"bufferView\":" + std::to_string(v_joint) + ",\"componentType\":5121,\"count\":" + N + ",\"type\":\"VEC4\"},"
          "{\"bufferView\":" + std::to_string(v_weight) + ",\"componentType\":5126,\"count\":" + N + ",\"type\":\"VEC4\"},"
          "{\"bufferView\":" + std::to_string(v_index) + ",\"componentType\":5123,\"count\":" + std::to_string(indices.size()) + ",\"type\":\"SCALAR\"},"
-         "{\"bufferView\":" + std::to_string(v_ibm) + ",\"componentType\":5126,\"count\":2,\"type\":\"MAT4\"},"
+         "{\"bufferView\":" + std::to_string(v_ibm) + ",\"componentType\":5126,\"count\":" + std::to_string(ibm.size() / 16) +
+         ",\"type\":\"MAT4\"},"
          "{\"bufferView\":" + std::to_string(v_time) + ",\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},"
          "{\"bufferView\":" + std::to_string(v_rot) + ",\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
          "{\"bufferView\":" + std::to_string(v_tr) + ",\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],";
     j += "\"bufferViews\":[";
-    for (std::size_t i = 0; i < views.size(); ++i)
-        j += (i ? "," : "") + std::string("{\"buffer\":0,\"byteOffset\":") + std::to_string(views[i].offset) +
-             ",\"byteLength\":" + std::to_string(views[i].length) + "}";
+    for (std::size_t i = 0; i < views.size(); ++i) {
+        if (i) j += ",";
+        j += "{\"buffer\":0,\"byteOffset\":" + std::to_string(views[i].offset) + ",\"byteLength\":" +
+             std::to_string(views[i].length) + "}";
+    }
     j += "],\"buffers\":[{\"byteLength\":" + std::to_string(buffer.size()) +
          ",\"uri\":\"data:application/octet-stream;base64," + base64(buffer) + "\"}]}";
     std::ofstream(path, std::ios::binary) << j;
