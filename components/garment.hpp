@@ -176,8 +176,8 @@ struct Garment {
     Matrix3X list_anchor_x;                  ///< Particle positions (anchor frame) when each list was built.
     std::vector<Real> list_epoch_move;       ///< Per particle: ellipsoid displacement since the epoch when its list was built.
     std::vector<Affine3> list_anchor_frames; ///< Unit sphere -> anchor frame of each collider at the epoch (last full build).
-    VectorX list_frame_move;                 ///< Per particle: largest collider displacement from its reference when its list was refreshed, m.
-    std::vector<Real> list_particle_move;    ///< Per collider: largest particle displacement from its reference when its bit was refreshed, m.
+    VectorX list_budget_m;                   ///< Per particle: how far it and the colliders may move before its list could miss one, m.
+    VectorX list_slack_m;                    ///< Per particle: what is left of that budget after the last list update, m.
     Matrix3X list_scratch;                   ///< Anchor-frame positions, reused by the list bookkeeping every substep.
 
     GarmentCounters counters;
