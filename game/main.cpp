@@ -1,4 +1,5 @@
 // The `drape` command: play the sample scene, inspect characters, run benchmarks.
+// Exit codes (every subcommand): 0 done, 1 bad input or a failed run (game/commands.hpp).
 #include <vector>
 
 #include "game/commands.hpp"
@@ -15,10 +16,5 @@ int main(int argc, char** argv) {
     // No subcommand: play the sample scene.
     std::vector<const char*> args(argv, argv + argc);
     if (argc == 1) args.push_back("play");
-    try {
-        app.parse(static_cast<int>(args.size()), args.data());
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
-    }
-    return drape::command_exit_code();
+    return drape::run_command_line(app, static_cast<int>(args.size()), args.data());
 }
