@@ -1,17 +1,21 @@
 // `drape play`: builds a scene (the sample scene by default), runs it for a number of
 // frames, writes what was asked (PNG frames, a video, a trace, stats) and prints the frame
 // budget. Usage and options: README.md "Playing scenes" and `drape play --help`.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <regex>
 #include <string>
 #include <thread>
 #include <tuple>
+#include <vector>
 
 #include "game/commands.hpp"
+#include "game/output_files.hpp"
 #include "game/scene.hpp"
 #include "game/stats.hpp"
 #include "game/video.hpp"
@@ -37,7 +41,7 @@ struct PlayOptions {
     std::optional<int> threads;
     std::optional<double> time_scale;
     double fps = 60;
-    bool headless = false, window = false;
+    bool headless = false, window = false, overwrite = false;
 };
 
 // Ctrl-C stops the loop between frames, so the video, stats and trace are still complete.
@@ -47,9 +51,58 @@ void on_interrupt(int) { g_interrupted = 1; }
 // Errors of this command: "drape play: --size: must be WxH ..." on stderr, exit code 1.
 int report(const std::string& message) {
     std::fprintf(stderr, "drape play: %s\n", message.c_str());
-    command_exit_code() = 1;
-    return 1;
+    command_exit_code() = exit_bad_input;
+    return exit_bad_input;
 }
+
+// The frames `--out DIR` writes: frame_00000.png, frame_00001.png, ...
+bool is_frame_file(const fs::path& file) {
+    static const std::regex name(R"(frame_\d{5}\.png)");
+    return std::regex_match(file.filename().string(), name);
+}
+
+std::vector<fs::path> frame_files(const fs::path& folder) {
+    std::vector<fs::path> out;
+    std::error_code ec;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
+        if (is_frame_file(it->path())) out.push_back(it->path());
+    return out;
+}
+
+// Everything this run creates (folders, frames), removed again unless the run completes:
+// a run that fails leaves nothing behind and never removes what existed before it.
+class CreatedOutputs {
+public:
+    CreatedOutputs() = default;
+    CreatedOutputs(const CreatedOutputs&) = delete;
+    CreatedOutputs& operator=(const CreatedOutputs&) = delete;
+    ~CreatedOutputs() {
+        if (m_kept) return;
+        std::error_code ec;
+        for (const fs::path& f : m_files) fs::remove(f, ec);
+        for (auto it = m_folders.rbegin(); it != m_folders.rend(); ++it) fs::remove(*it, ec);  // only when empty
+    }
+    // Creates `folder` and its missing parents, remembering each one it made.
+    Result<void> create_folder(const fs::path& folder) {
+        std::vector<fs::path> missing;
+        std::error_code ec;
+        for (fs::path p = folder; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+            missing.push_back(p);
+            if (p == p.parent_path()) break;
+        }
+        for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+            if (!fs::create_directory(*it, ec) && ec) return fail(it->string() + ": cannot create the folder: " + ec.message());
+            m_folders.push_back(*it);
+        }
+        return {};
+    }
+    void add_file(const fs::path& file) { m_files.push_back(file); }
+    void keep() { m_kept = true; }
+
+private:
+    std::vector<fs::path> m_files, m_folders;
+    bool m_kept = false;
+};
 
 Result<std::pair<int, int>> parse_size(const std::string& text) {
     int w = 0, h = 0;
@@ -111,11 +164,8 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
 }
 
 int play(const PlayOptions& o) {
-    // --- Checks that need no scene. (CLI11's range checks let NaN through.)
-    if (!std::isfinite(o.fps) || o.fps < 1 || o.fps > 1000)
-        return report("--fps: must be a number in [1, 1000], got " + std::to_string(o.fps));
-    if (o.time_scale && (!std::isfinite(*o.time_scale) || *o.time_scale < 0 || *o.time_scale > 1000))
-        return report("--time-scale: must be a number in [0, 1000], got " + std::to_string(*o.time_scale));
+    // --- Checks that need no scene; nothing is written before every input is checked.
+    // (Option ranges, NaN included, are checked by the command line's validators.)
     std::pair<int, int> size{1280, 720};
     if (!o.size.empty()) {
         auto s = parse_size(o.size);
@@ -140,14 +190,22 @@ int play(const PlayOptions& o) {
     if (!o.out.empty()) {
         std::error_code ec;
         if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) return report("--out: " + o.out + " exists and is not a folder");
+        if (!o.overwrite && fs::is_directory(o.out, ec) && !frame_files(o.out).empty())
+            return report("--out: " + o.out + " already holds frames (frame_00000.png, ...); add --overwrite to replace them");
     }
-    for (const auto& [name, file] : {std::pair{"--stats", o.stats}, std::pair{"--trace", o.trace}, std::pair{"--video", o.video}}) {
+    const std::array<std::pair<const char*, std::string>, 3> files{
+        {{"--stats", o.stats}, {"--trace", o.trace}, {"--video", o.video}}};
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        const auto& [name, file] = files[i];
         if (file.empty()) continue;
         std::error_code ec;
         const fs::path folder = fs::path(file).parent_path();
         if (!folder.empty() && !fs::is_directory(folder, ec))
             return report(std::string(name) + ": folder " + folder.string() + " does not exist");
-        if (fs::is_directory(file, ec)) return report(std::string(name) + ": " + file + " is a folder");
+        if (auto ok = check_new_file(name, file, o.overwrite); !ok) return report(ok.error().message);
+        for (std::size_t k = 0; k < i; ++k)
+            if (!files[k].second.empty() && fs::path(files[k].second).lexically_normal() == fs::path(file).lexically_normal())
+                return report(std::string(name) + ": " + file + " is also the " + files[k].first + " file");
     }
 
     // --- The scene.
@@ -166,27 +224,8 @@ int play(const PlayOptions& o) {
     if (auto ok = apply_overrides(scene, o); !ok) return report(ok.error().message);
     if (auto ok = validate(scene); !ok) return report(ok.error().message);
 
-    // --- Where frames go. Off-screen with no output named: a new video (or frame folder) under out/.
+    // --- The world (nothing has been written yet).
     const bool window = o.window && !headless;
-    fs::path video_file = o.video, frame_folder = o.out;
-    if (!headless && !window && o.video.empty() && o.out.empty()) {
-        const std::string stem = o.scene.empty() ? (o.character.empty() ? "sample" : fs::path(o.character).stem().string())
-                                                 : fs::path(o.scene).stem().string();
-        std::error_code ec;
-        fs::create_directories("out", ec);
-        if (ec) return report("out/: cannot create the output folder: " + ec.message());
-        if (find_ffmpeg())
-            video_file = fresh_path("out", stem, ".mp4");
-        else
-            frame_folder = fresh_path("out", stem + "_frames", "");
-    }
-    if (!frame_folder.empty()) {
-        std::error_code ec;
-        fs::create_directories(frame_folder, ec);
-        if (ec) return report("--out: cannot create " + frame_folder.string() + ": " + ec.message());
-    }
-
-    // --- The world.
     WorldOptions options;
     options.render = !headless;
     options.window = window;
@@ -202,12 +241,29 @@ int play(const PlayOptions& o) {
         return report(message);
     }
     World& world = *built;
+    for (const std::string& warning : world.warnings) std::fprintf(stderr, "drape play: warning: %s\n", warning.c_str());
+
+    // --- Where frames go, created only now that the input is known good. Off-screen with
+    // no output named: a new video (or frame folder) under out/, never over an old one.
+    CreatedOutputs created;
+    fs::path video_file = o.video, frame_folder = o.out;
+    if (!headless && !window && o.video.empty() && o.out.empty()) {
+        const std::string stem = o.scene.empty() ? (o.character.empty() ? "sample" : fs::path(o.character).stem().string())
+                                                 : fs::path(o.scene).stem().string();
+        if (auto ok = created.create_folder("out"); !ok) return report("out/: " + ok.error().message);
+        if (find_ffmpeg())
+            video_file = fresh_path("out", stem, ".mp4");
+        else
+            frame_folder = fresh_path("out", stem + "_frames", "");
+    }
+    if (!frame_folder.empty())
+        if (auto ok = created.create_folder(frame_folder); !ok) return report("--out: " + ok.error().message);
 
     const int frames = o.frames.value_or(window ? 0 : 240);  // window: until closed unless --frames
     const double frame_dt_s = 1.0 / o.fps;
     std::optional<VideoWriter> video;
     if (!video_file.empty()) {
-        auto opened = VideoWriter::open(video_file, size.first, size.second, o.fps);
+        auto opened = VideoWriter::open(partial_path(video_file), size.first, size.second, o.fps);
         if (!opened) return report(opened.error().message);
         video.emplace(std::move(*opened));
     }
@@ -269,6 +325,7 @@ int play(const PlayOptions& o) {
                 if (!frame_folder.empty()) {
                     char name[32];
                     std::snprintf(name, sizeof name, "frame_%05d.png", played - 1);
+                    created.add_file(frame_folder / name);
                     if (auto ok = write_png(image, frame_folder / name); !ok) return report(ok.error().message);
                 }
             }
@@ -276,8 +333,18 @@ int play(const PlayOptions& o) {
 #endif
     }
     std::signal(SIGINT, previous_handler);
-    if (video)
+    if (video) {
         if (auto ok = video->close(); !ok) return report(ok.error().message);
+        if (auto ok = commit_partial(video->file(), video_file); !ok) return report(ok.error().message);
+    }
+    // The folder now holds this run's frames only (older frames past the last one go).
+    if (!frame_folder.empty())
+        for (const fs::path& f : frame_files(frame_folder))
+            if (std::stoi(f.filename().string().substr(6, 5)) >= played) {
+                std::error_code ec;
+                fs::remove(f, ec);
+            }
+    created.keep();
     if (g_interrupted) std::printf("drape play: interrupted after %d frames\n", played);
 
     // --- Reports.
@@ -289,14 +356,28 @@ int play(const PlayOptions& o) {
     if (world.teleports->teleports > 0)
         std::printf(", %llu teleport(s)", static_cast<unsigned long long>(world.teleports->teleports));
     std::printf("\n");
-    if (video) std::printf("video: %s\n", video->file().c_str());
+    if (video) std::printf("video: %s\n", video_file.c_str());
     if (!frame_folder.empty() && !headless) std::printf("frames: %s/frame_%%05d.png\n", frame_folder.c_str());
     int status = 0;
     if (!o.trace.empty()) {
-        if (auto ok = world.scheduler.profiler().write_trace(o.trace); !ok) status = report("--trace: " + ok.error().message);
+        const fs::path partial = partial_path(o.trace);
+        auto ok = world.scheduler.profiler().write_trace(partial);
+        if (ok) ok = commit_partial(partial, o.trace);
+        if (!ok) {
+            std::error_code ec;
+            fs::remove(partial, ec);
+            status = report("--trace: " + ok.error().message);
+        }
     }
     if (!o.stats.empty()) {
-        if (auto ok = write_stats(run_stats(world), o.stats); !ok) status = report("--stats: " + ok.error().message);
+        const fs::path partial = partial_path(o.stats);
+        auto ok = write_stats(run_stats(world), partial);
+        if (ok) ok = commit_partial(partial, o.stats);
+        if (!ok) {
+            std::error_code ec;
+            fs::remove(partial, ec);
+            status = report("--stats: " + ok.error().message);
+        }
     }
     if (has_nonfinite(world)) status = report("the simulation produced non-finite values (see --stats FILE for which garment)");
     return status;
@@ -311,23 +392,25 @@ void add_play_command(CLI::App& app) {
     play_app->add_option("--character", o->character, "Character file (.glb/.gltf/.fbx/...) replacing the scene's first character");
     play_app->add_option("--clip", o->clip, "Clip of the first character: name or index");
     play_app->add_option("--garment", o->garment, "Dress the first character in a default skirt or dress, or nothing")
-        ->check(CLI::IsMember({"skirt", "dress", "none"}));
+        ->check(one_of({"skirt", "dress", "none"}));
     play_app->add_option("--model", o->model, "Garment model: the paper's simplified mass-spring or the classic baseline")
-        ->check(CLI::IsMember({"simplified", "classic"}));
+        ->check(one_of({"simplified", "classic"}));
     play_app->add_option("--frames", o->frames, "Frames to play (default 240; in a window: until closed)")
-        ->check(CLI::Range(1, 10'000'000));
+        ->check(integer_in(1, 10'000'000));
     play_app->add_flag("--headless", o->headless, "No rendering at all (no render system)");
     play_app->add_option("--out", o->out, "Write every frame as PNG into this folder");
     play_app->add_option("--video", o->video, "Write an H.264 video (frames piped to ffmpeg)");
     play_app->add_flag("--window", o->window, "Show the scene in an X11 window (mouse: orbit; keys: space, N, E, M, R, Q)");
     play_app->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 1280x720)");
     play_app->add_option("--fps", o->fps, "Frames per second of off-screen playback and video (default 60)")
-        ->check(CLI::Range(1.0, 1000.0));
+        ->check(number_in(1, 1000));
     play_app->add_option("--trace", o->trace, "Write Chrome trace event JSON (Perfetto, chrome://tracing)");
     play_app->add_option("--stats", o->stats, "Write run statistics JSON (systems, garments)");
-    play_app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024));
+    play_app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(integer_in(0, 1024));
     play_app->add_option("--time-scale", o->time_scale, "Simulated seconds per wall-clock second (slow motion < 1)")
-        ->check(CLI::Range(0.0, 1000.0));
+        ->check(number_in(0, 1000));
+    play_app->add_flag("--overwrite", o->overwrite,
+                       "Replace the --stats, --trace, --video files and --out frames if they exist (else: an error)");
     play_app->callback([o] { command_exit_code() = play(*o); });
 }
 

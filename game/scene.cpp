@@ -84,6 +84,7 @@ void grid_for(int particles, int default_lines, int default_rows, int stride, in
     const int s = std::max(1, stride);
     lines = std::max(s * 2, static_cast<int>(std::lround(std::sqrt(particles / aspect) / s)) * s);
     rows = std::max(2, static_cast<int>(std::lround(double(particles) / lines)));
+    rows = std::min(rows, max_garment_particles / lines);  // rounding must not pass the builders' limit
 }
 
 // Scene parameters onto the builder's parameter struct (SkirtParams or DressParams).
@@ -242,6 +243,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
             auto imported = import_character(c.file);
             if (!imported) return fail(located(c.where, field, imported.error().message));
             asset = *imported;
+            world.warnings.insert(world.warnings.end(), asset->warnings.begin(), asset->warnings.end());
         }
         SpawnOptions spawn;
         spawn.transform.position = c.position_m;

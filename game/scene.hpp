@@ -22,6 +22,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/core/error.hpp"
@@ -58,6 +59,7 @@ struct World {
     GarmentWatch watch;                  ///< Worst strain, penetration, non-finite values.
     std::shared_ptr<TeleportLog> teleports = std::make_shared<TeleportLog>();
     std::shared_ptr<void> thread_limit;  ///< Keeps solver.threads in force while the world lives.
+    std::vector<std::string> warnings;   ///< What loading accepted with a remark (CharacterAsset::warnings), one line each.
 };
 
 /// Loads the characters, fits and overrides their colliders, dresses them, adds the

@@ -7,9 +7,10 @@
 // code, `drape play --scene` reads one from a file.
 //
 // Errors are one line naming the file, line and column and the field path, e.g.
-//   scene.json:7:21: garments[0].particles: must be an integer in [16, 1000000], got -3
+//   scene.json:7:21: garments[0].particles: must be an integer in [16, 250000], got -3
 // Unknown fields are errors (a typo must not be silently ignored), and so are absurd
-// values: non-finite numbers, zero or negative sizes, particle counts above 1,000,000.
+// values: non-finite numbers, zero or negative sizes, more particles than a garment may
+// have (max_garment_particles, 250,000).
 // Relative paths resolve against the scene file's folder.
 #pragma once
 
@@ -23,6 +24,7 @@
 #include "components/garment.hpp"
 #include "engine/core/error.hpp"
 #include "engine/core/math.hpp"
+#include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
 
@@ -139,8 +141,8 @@ struct GarmentParameterSpec {
 /// "particles" is a target count that chooses warp_lines and particles_per_line.
 [[nodiscard]] const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type);
 
-/// Upper bound on particles per garment accepted from a scene.
-inline constexpr int max_scene_particles = 1'000'000;
+/// Upper bound on particles per garment accepted from a scene: the garment builders' own.
+inline constexpr int max_scene_particles = max_garment_particles;
 
 /// Reads and checks a scene file. Relative paths resolve against its folder; character
 /// files must exist.

@@ -57,7 +57,7 @@ TEST(DefaultAvatar, CommittedFileIsTheGeneratorsOutput) {
     ASSERT_FALSE(avatar_bytes().empty());
     EXPECT_EQ(committed.size(), avatar_bytes().size());
     EXPECT_TRUE(committed == avatar_bytes())
-        << committed_avatar << " differs from the generator's output: run `drape make-avatar` and commit it";
+        << committed_avatar << " differs from the generator's output: run `drape make-avatar --overwrite` and commit it";
 }
 
 TEST(DefaultAvatar, HasAFewThousandTrianglesAndAboutTwentyFiveBones) {

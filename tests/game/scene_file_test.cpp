@@ -140,7 +140,7 @@ TEST_F(SceneFileTest, FieldErrorPointsAtTheValue) {
                              "     \"particles\": -3}\n"
                              "  ]\n"
                              "}";
-    EXPECT_EQ(error(text), "scene.json:5:19: garments[0].particles: must be an integer in [16, 1000000], got -3");
+    EXPECT_EQ(error(text), "scene.json:5:19: garments[0].particles: must be an integer in [16, 250000], got -3");
 }
 
 TEST_F(SceneFileTest, WrongTypesAreNamed) {
@@ -193,10 +193,15 @@ TEST_F(SceneFileTest, ZeroNegativeAndNonFiniteSizesAreRejected) {
 
 TEST_F(SceneFileTest, AbsurdParticleCountsAreRejected) {
     const std::string head = R"({"characters": [{"file": "chars/body.glb"}], "garments": [{"particles": )";
-    EXPECT_EQ(error(head + "2000000}]}"), "scene.json:1:73: garments[0].particles: must be an integer in [16, 1000000], got 2000000");
+    EXPECT_EQ(error(head + "2000000}]}"), "scene.json:1:73: garments[0].particles: must be an integer in [16, 250000], got 2000000");
     EXPECT_EQ(error(head + "18446744073709551616}]}"),
-              "scene.json:1:73: garments[0].particles: must be an integer in [16, 1000000], got number 1.8446744073709552e+19");
-    EXPECT_EQ(error(head + "0}]}"), "scene.json:1:73: garments[0].particles: must be an integer in [16, 1000000], got 0");
+              "scene.json:1:73: garments[0].particles: must be an integer in [16, 250000], got number 1.8446744073709552e+19");
+    EXPECT_EQ(error(head + "0}]}"), "scene.json:1:73: garments[0].particles: must be an integer in [16, 250000], got 0");
+    // The limit is the garment builders' own, so a scene, a command line and C++ agree.
+    EXPECT_EQ(max_scene_particles, max_garment_particles);
+    EXPECT_EQ(error(head + "1000000}]}"), "scene.json:1:73: garments[0].particles: must be an integer in [16, 250000], got 1000000");
+    const std::string grid = R"({"characters": [{"file": "chars/body.glb"}], "garments": [{"warp_lines": 999, "particles_per_line": 999}]})";
+    EXPECT_EQ(error(grid), "scene.json:1:74: garments[0].warp_lines: warp_lines x particles_per_line must be at most 250000 particles, got 998001");
 }
 
 TEST_F(SceneFileTest, MissingCharacterFileNamesFileAndField) {
@@ -235,7 +240,7 @@ TEST_F(SceneFileTest, CodeBuiltDescriptionsAreValidatedWithFieldNames) {
     scene.garments[0].parameters = {{"particles", 5e6}};
     auto r = validate(scene);
     ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().message, "garments[0].particles: must be an integer in [16, 1000000], got 5000000");
+    EXPECT_EQ(r.error().message, "garments[0].particles: must be an integer in [16, 250000], got 5000000");
 }
 
 // Random byte-level and token-level mutations of a valid scene: the parser must always

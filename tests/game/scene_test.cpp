@@ -12,6 +12,7 @@
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
 #include "game/scene.hpp"
+#include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
 namespace {
@@ -210,6 +211,29 @@ TEST(BuildWorld, BadScenesNameTheField) {
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().message.rfind("characters[0].file: ", 0), 0u) << r.error().message;
     EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+}
+
+TEST(ParticleLimit, OneLimitForScenesAndCppBuilders) {
+    // A C++ builder refuses an absurd grid with the fields and the limit...
+    SkirtParams skirt;
+    skirt.warp_lines = 1002;
+    skirt.particles_per_line = 1000;
+    auto r = validate(skirt);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message, "skirt.warp_lines x skirt.particles_per_line: must be at most 250000 particles, got 1002 x 1000 = 1002000");
+    DressParams dress;
+    dress.warp_lines = 501;
+    dress.particles_per_line = 500;
+    EXPECT_FALSE(validate(dress));
+    // ... and a scene asking for the most particles gets a garment within the same limit
+    // (the grid's rounding may not pass it).
+    SceneDescription scene = sample();
+    scene.garments[0].parameters = {{"particles", double(max_garment_particles)}};
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    const Garment& g = world->registry.get<Garment>(world->garments[0]);
+    EXPECT_LE(g.x.cols(), max_garment_particles);
+    EXPECT_GT(g.x.cols(), max_garment_particles * 9 / 10);
 }
 
 TEST(BuildWorld, ErrorsFromAFileCarryItsPosition) {
