@@ -482,7 +482,7 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
         r.fail_at(f.path("particles"), "give either particles or warp_lines and particles_per_line, not both");
     if (const GarmentParameter *w = param("warp_lines"), *m = param("particles_per_line"); w && m && w->value * m->value > max_scene_particles)
         r.fail_at(f.path("warp_lines"), cat("warp_lines x particles_per_line must be at most ", std::to_string(max_scene_particles),
-                                            " particles, got ", number_text(w->value * m->value)));
+                                            " particles, got ", std::to_string(static_cast<long long>(w->value) * static_cast<long long>(m->value))));
     return g;
 }
 
