@@ -262,9 +262,16 @@ int play(const PlayOptions& o) {
     const int frames = o.frames.value_or(window ? 0 : 240);  // window: until closed unless --frames
     const double frame_dt_s = 1.0 / o.fps;
     std::optional<VideoWriter> video;
+    // Video errors name the file the user knows, not the partial one being written.
+    const std::string partial_video = video_file.empty() ? std::string() : partial_path(video_file).string();
+    auto video_error = [&](std::string message) {
+        if (const auto at = message.find(partial_video); !partial_video.empty() && at != std::string::npos)
+            message.replace(at, partial_video.size(), video_file.string());
+        return report((o.video.empty() ? "" : "--video: ") + message);
+    };
     if (!video_file.empty()) {
-        auto opened = VideoWriter::open(partial_path(video_file), size.first, size.second, o.fps);
-        if (!opened) return report(opened.error().message);
+        auto opened = VideoWriter::open(partial_video, size.first, size.second, o.fps);
+        if (!opened) return video_error(opened.error().message);
         video.emplace(std::move(*opened));
     }
 
@@ -321,7 +328,7 @@ int play(const PlayOptions& o) {
             if (video || !frame_folder.empty()) {
                 if (auto ok = world.renderer->read_pixels(image); !ok) return report(ok.error().message);
                 if (video)
-                    if (auto ok = video->write(image); !ok) return report(ok.error().message);
+                    if (auto ok = video->write(image); !ok) return video_error(ok.error().message);
                 if (!frame_folder.empty()) {
                     char name[32];
                     std::snprintf(name, sizeof name, "frame_%05d.png", played - 1);
@@ -334,7 +341,7 @@ int play(const PlayOptions& o) {
     }
     std::signal(SIGINT, previous_handler);
     if (video) {
-        if (auto ok = video->close(); !ok) return report(ok.error().message);
+        if (auto ok = video->close(); !ok) return video_error(ok.error().message);
         if (auto ok = commit_partial(video->file(), video_file); !ok) return report(ok.error().message);
     }
     // The folder now holds this run's frames only (older frames past the last one go).

@@ -193,6 +193,25 @@ TEST_F(PlayCommand, FrameFoldersAreReplacedOnlyWithOverwrite) {
     }
 }
 
+TEST_F(PlayCommand, AVideoThatFailsMidRunLeavesNoPartialFileAndKeepsTheOldOne) {
+    if (!render_available()) GTEST_SKIP() << "built without the render module";
+    // An ffmpeg that dies at once: the first frame written fails.
+    fs::create_directories(m_dir / "bin");
+    std::ofstream(m_dir / "bin" / "ffmpeg") << "#!/bin/sh\nexit 3\n";
+    fs::permissions(m_dir / "bin" / "ffmpeg", fs::perms::owner_all);
+    const std::string path = "PATH='" + (m_dir / "bin").string() + ":/usr/bin:/bin'";
+    PlayRun run = play("--frames 3 --size 64x48", m_dir, path);  // default output: out/sample.mp4
+    EXPECT_EQ(run.status, 1);
+    EXPECT_NE(run.output.find("drape play: out/sample.mp4: ffmpeg stopped accepting frames"), std::string::npos) << run.output;
+    EXPECT_FALSE(fs::exists(m_dir / "out")) << "the folder this run created is removed again";
+    std::ofstream(m_dir / "clip.mp4") << "an older video";
+    run = play("--frames 3 --size 64x48 --video clip.mp4 --overwrite", m_dir, path);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_NE(run.output.find("drape play: --video: clip.mp4: ffmpeg stopped accepting frames"), std::string::npos) << run.output;
+    EXPECT_EQ(read(m_dir / "clip.mp4"), "an older video");
+    EXPECT_FALSE(fs::exists(m_dir / ".clip.partial.mp4"));
+}
+
 TEST_F(PlayCommand, MakeAvatarKeepsAnIdenticalFileAndRefusesToReplaceAnother) {
     PlayRun run = drape("make-avatar --out avatar.glb", m_dir);
     ASSERT_EQ(run.status, 0) << run.output;
