@@ -13,6 +13,7 @@
 
 #include "game/scene.hpp"
 #include "game/video.hpp"
+#include "tests/character/test_character_file.hpp"
 
 namespace drape {
 namespace {
@@ -210,6 +211,21 @@ TEST_F(PlayCommand, AVideoThatFailsMidRunLeavesNoPartialFileAndKeepsTheOldOne) {
     EXPECT_NE(run.output.find("drape play: --video: clip.mp4: ffmpeg stopped accepting frames"), std::string::npos) << run.output;
     EXPECT_EQ(read(m_dir / "clip.mp4"), "an older video");
     EXPECT_FALSE(fs::exists(m_dir / ".clip.partial.mp4"));
+}
+
+TEST_F(PlayCommand, ImportWarningsArePrintedAndTheCharacterPlays) {
+    // An unweighted end bone at its parent's joint: accepted, with one warning line.
+    test::write_test_character({.end_bone_offset_m = 0}, m_dir / "column.gltf");
+    PlayRun run = play("--headless --frames 2 --character column.gltf --garment none", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_NE(run.output.find("drape play: warning: column.gltf: 1 zero-length end bone without skinned vertices, ignored: 'ChildEnd'\n"),
+              std::string::npos) << run.output;
+    // The same bone with vertices skinned to it is an error naming the option, file and bone.
+    test::write_test_character({.child_offset_m = 0}, m_dir / "folded.gltf");
+    run = play("--headless --frames 2 --character folded.gltf --garment none", m_dir);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_EQ(run.output, "drape play: --character: folded.gltf: bone 'Root' has zero length in the rest pose (its child joints sit "
+                          "at its own joint) but 24 vertices are skinned to it\n");
 }
 
 TEST_F(PlayCommand, MakeAvatarKeepsAnIdenticalFileAndRefusesToReplaceAnother) {
