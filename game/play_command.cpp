@@ -193,6 +193,11 @@ int play(const PlayOptions& o) {
         if (!o.overwrite && fs::is_directory(o.out, ec) && !frame_files(o.out).empty())
             return report("--out: " + o.out + " already holds frames (frame_00000.png, ...); add --overwrite to replace them");
     }
+    if (!headless && !o.window && o.video.empty() && o.out.empty()) {  // the default output goes under out/
+        std::error_code ec;
+        if (fs::exists("out", ec) && !fs::is_directory("out", ec))
+            return report("out: exists and is not a folder (the default output goes there; name one with --video or --out)");
+    }
     const std::array<std::pair<const char*, std::string>, 3> files{
         {{"--stats", o.stats}, {"--trace", o.trace}, {"--video", o.video}}};
     for (std::size_t i = 0; i < files.size(); ++i) {

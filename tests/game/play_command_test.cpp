@@ -182,6 +182,12 @@ TEST_F(PlayCommand, FrameFoldersAreReplacedOnlyWithOverwrite) {
     EXPECT_TRUE(fs::exists(m_dir / "frames" / "frame_00001.png"));
     EXPECT_FALSE(fs::exists(m_dir / "frames" / "frame_00002.png"));
     EXPECT_EQ(read(m_dir / "frames" / "notes.txt"), "keep");
+    // The default output's folder is a file: refused before anything runs.
+    std::ofstream(m_dir / "out") << "a file named out";
+    run = play("--frames 2 --size 64x48", m_dir);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_EQ(run.output, "drape play: out: exists and is not a folder (the default output goes there; name one with --video or --out)\n");
+    EXPECT_EQ(read(m_dir / "out"), "a file named out");
     if (find_ffmpeg()) {
         std::ofstream(m_dir / "clip.mp4") << "not a video";
         run = play("--frames 2 --size 64x48 --video clip.mp4", m_dir);
