@@ -13,11 +13,6 @@
 #include "systems/cloth/weft.hpp"
 
 namespace drape {
-namespace {
-// Symmetric Provot passes over the layer-2 warp springs after the placement (method §4.2).
-constexpr int layer2_passes = 4;
-}  // namespace
-
 void prepare_garment(Garment& g) {
     const GarmentTopology& t = *g.topology;
     const Eigen::Index n = static_cast<Eigen::Index>(t.particle_count());
@@ -93,17 +88,12 @@ void constrain_garment(Garment& g, const FrameContext& ctx) {
         weft1.ordered_pass = false;
         limit_strain(t.weft1, g.x, g.v, g.movable, weft1);
         limit_strain(t.warp1, g.x, g.v, g.movable, o);
-        // §4.2: layer 2 placed in its planes from layer 1, its bulge limited (weft.hpp).
+        // §4.2: layer 2 placed in its planes from layer 1. Provot on the layer-2 springs
+        // (item 3) is part of the placement: each particle's one free coordinate is kept where
+        // its warp spring and weft segments hold the limit (weft.hpp), so after this no
+        // layer-2 warp spring below a free particle exceeds 1.10 x rest either.
         compute_layer1_normals(t, g.x, g.normals);
         place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, o.h_s, o.limit);
-        // §4.2 item 3: Provot between placed particles on the layer-2 warp, symmetric passes,
-        // each particle kept in its plane, layer 1 and the pins fixed. (An ordered pass or a
-        // pass over the weft segments here makes the worst strain larger: docs/cloth.md.)
-        StrainLimitOptions layer2 = o;
-        layer2.plane_normal = &g.plane_normal;
-        layer2.iterations = layer2_passes;
-        layer2.ordered_pass = false;
-        limit_strain(t.warp2, g.x, g.v, g.movable_weft, layer2);
     } else {
         StrainLimitOptions weft = o;
         weft.ordered_pass = false;

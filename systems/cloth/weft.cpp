@@ -33,7 +33,15 @@ void compute_layer1_normals(const GarmentTopology& t, const Matrix3X& x, Matrix3
 
 void place_weft(const GarmentTopology& t, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,
                 Matrix3X& v, Matrix3X& plane_normal, Real h, Real limit) {
+    constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
     const Real stride = Real(t.weft_stride);
+    const Real stretch = 1 + limit;
+    const auto chord_point = [&](std::size_t k) {
+        return Vec3((1 - t.weft_t[k]) * x.col(t.weft_left[k]) + t.weft_t[k] * x.col(t.weft_right[k]));
+    };
+    const auto within = [&](const Vec3& xi, std::uint32_t above, Real rest) {
+        return (xi - x.col(above)).squaredNorm() <= stretch * stretch * rest * rest;
+    };
     for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
         const std::uint32_t i = t.weft_particle[k];
         if (inv_mass[i] == 0) {  // pinned in the fitting zone
@@ -47,23 +55,56 @@ void place_weft(const GarmentTopology& t, const Matrix3X& normals, const VectorX
         vi -= p.dot(vi) * p;
         const Vec3 edge = x.col(b) - x.col(a);
         const Real edge_length = edge.norm();
-        const Vec3 q = (1 - s) * x.col(a) + s * x.col(b);
+        const Vec3 q = chord_point(k);
         Vec3 xi = q;
         if (edge_length > Real(1e-9) && p.squaredNorm() > 0) {
             const Vec3 u = p.cross(edge / edge_length);
-            const Real l = (1 + limit) * t.weft_rest_m[k];
+            // Weft interval W = [-beta/2, beta/2] (step 3); it always holds 0.
+            const Real l = stretch * t.weft_rest_m[k];
             const Real along = edge_length / stride;
-            const Real beta = l > along ? std::sqrt(l * l - along * along) : Real(0);
-            Real bulge = std::clamp((x.col(i) + h * vi - q).dot(u), -beta / 2, beta / 2);
+            const Real half_beta = l > along ? std::sqrt(l * l - along * along) / 2 : Real(0);
+            const Real wanted = std::clamp((x.col(i) + h * vi - q).dot(u), -half_beta, half_beta);
+            Real bulge = wanted;
             const std::uint32_t above = t.weft_above[k];
-            if (above != std::numeric_limits<std::uint32_t>::max()) {
-                // |q + b u - x_above| <= l_warp  <=>  (b + c)^2 <= l_warp^2 - |d|^2 + c^2.
-                const Vec3 d = q - x.col(above);
-                const Real c = d.dot(u);
-                const Real l_warp = (1 + limit) * t.weft_above_rest_m[k];
-                const Real room = l_warp * l_warp - d.squaredNorm() + c * c;
-                const Real half = room > 0 ? std::sqrt(room) : Real(0);
-                bulge = std::clamp(bulge, -c - half, -c + half);
+            if (above != none) {
+                // Warp interval I: |q + b u - x_above| <= l_warp  <=>  (b + c)^2 <= l_warp^2 - |d|^2 + c^2.
+                const Real l_warp = stretch * t.weft_above_rest_m[k];
+                // I within [-w, w]: false when empty.
+                const auto warp_room = [&](Real& low, Real& high, Real w) {
+                    const Vec3 d = q - x.col(above);
+                    const Real c = d.dot(u);
+                    const Real room = l_warp * l_warp - d.squaredNorm() + c * c;
+                    if (room < 0) return false;
+                    low = std::max(-w, -c - std::sqrt(room));
+                    high = std::min(w, -c + std::sqrt(room));
+                    return low <= high;
+                };
+                Real low = 0, high = 0;
+                const bool hangs_from_pin = inv_mass[above] == 0;
+                bool feasible = warp_room(low, high, half_beta);
+                if (!feasible && !hangs_from_pin) {
+                    // No bulge satisfies both: the particles above on this line go back onto
+                    // their chords, from here upward until the spring above the topmost one
+                    // holds. On chords, a warp spring is the blend of the two layer-1 warp
+                    // springs beside it (at most 1.10 x rest), so 0 is then in I.
+                    for (std::size_t j = k; j-- > 0 && t.weft_particle[j] == t.weft_above[j + 1];) {
+                        const std::uint32_t pj = t.weft_particle[j], over = t.weft_above[j];
+                        if (inv_mass[pj] == 0) break;
+                        x.col(pj) = chord_point(j);
+                        if (over == none || inv_mass[over] == 0 || within(x.col(pj), over, t.weft_above_rest_m[j])) break;
+                    }
+                    feasible = warp_room(low, high, half_beta);
+                }
+                if (!feasible) {
+                    // Below a pinned row (whose skin points need not lie near this plane): the
+                    // warp spring before the weft; if no bulge holds it, the nearest one.
+                    // Elsewhere (only when the layer-1 warp beside it is over the limit, e.g.
+                    // between pinned rows): the nearest one within W.
+                    const Real c = (q - x.col(above)).dot(u);
+                    if (!hangs_from_pin) low = high = std::clamp(-c, -half_beta, half_beta);
+                    else if (!warp_room(low, high, std::numeric_limits<Real>::infinity())) low = high = -c;
+                }
+                bulge = std::clamp(wanted, low, high);
             }
             xi += bulge * u;
         }

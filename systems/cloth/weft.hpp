@@ -11,12 +11,24 @@
 //      in-plane direction across the edge. The bulge is what it had after the last
 //      substep (the collision pushes it out of the body), carried by the velocity:
 //      b = (x + h v - q) . u.
-//   3. Provot on the weft (§4.2 item 3): the bulge is the only free coordinate, so the
-//      correction is a clamp |b| <= beta / 2 with beta = sqrt(l^2 - (|e| / stride)^2),
-//      l = (1 + limit) x rest: each weft segment, whose along-edge part is |e| / stride,
-//      then stays within the limit whenever the layer-1 weft spring does; and, line by
-//      line from the pins outward, b is kept in the interval that holds the warp spring
-//      to the particle above within (1 + limit) x rest (a 1-D Provot correction).
+//   3. Provot on layer 2 (§4.2 item 3), on the one free coordinate b, from the pins outward:
+//      - weft: W = [-beta/2, beta/2], beta = sqrt(l^2 - (|e| / stride)^2), l = (1 + limit)
+//        x the mean rest of the weft segments between a and b. With every bulge of a row in
+//        W, each weft segment is at most l (its along-edge part is |e| / stride); when the
+//        chord itself is longer than stride x l, W = {0} and the segments are |e| / stride.
+//      - warp: I = the bulges that keep the spring to the particle above (placed first)
+//        within (1 + limit) x rest. b = the carried bulge clamped to I and W.
+//      - When I and W do not meet, the particles above on the same line go back onto their
+//        chords (b = 0), upward until the spring above the topmost one holds. On chords a
+//        layer-2 warp spring is the blend (1 - t) d_a + t d_b of the two layer-1 warp
+//        springs beside it, so its length is at most the same blend of theirs: within
+//        (1 + limit) x rest when theirs are (Provot's ordered pass, §4.1) and its rest is
+//        that blend of their rests (grid builders: equal). 0 is then in I and in W.
+//   Guarantees after the placement: every layer-2 warp spring whose upper end is free is
+//   at most (1 + limit) x rest; every weft segment beside a free layer-2 particle that does
+//   not hang from a pinned one is at most max(l, |e| / stride). A particle hanging from a
+//   pinned one gets its warp spring first (I alone if it misses W, else the nearest bulge):
+//   the fitting zone's skin points curve around the body, off the planes below them.
 //   Layer-2 particles are listed line by line from the pins outward, so the particle
 //   above is always placed first.
 #pragma once

@@ -43,30 +43,31 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringLongerThanTenPercentAfterTheConstra
     const Entity e = *attach_skirt(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
     const GarmentTopology& t = *g.topology;
-    // Classic: Provot on every warp spring. Simplified: Provot on the layer-1 warp (§4.1),
-    // the warp lines proper; a layer-2 particle only moves in its plane (§4.2) and its
-    // warp spring is limited as far as that plane allows: where the cloth folds, the plane
-    // of the next row can lie farther than the limit from the particle above. That strain
-    // is reported (GarmentCounters::max_strain), not asserted.
+    // Classic: Provot on every warp spring. Simplified: Provot on the layer-1 warp (§4.1);
+    // the layer-2 warp springs through the placement (§4.2, weft.hpp), every one whose
+    // upper end is free. A spring hanging from a pinned layer-2 particle is bounded only as
+    // far as that particle's skin point lies near the plane below it (reported, not asserted).
     const bool classic = GetParam() == ClothModel::classic;
     int checks = 0;
-    Real worst_layer2 = 0;
+    Real worst_below_pins = 0;
+    std::size_t layer2_checked = 0;
     walk(body, registry, g, 120, [&](Garment& garment, const FrameContext&) {
         for (const SpringPhase* warp : {&t.warp1, &t.warp2}) {
-            const bool exact = classic || warp == &t.warp1;
             for (std::size_t s = 0; s < warp->size(); ++s) {
                 const Real length = (garment.x.col(warp->b[s]) - garment.x.col(warp->a[s])).norm();
-                if (exact) {
-                    ASSERT_LE(length, Real(1.10) * warp->rest_m[s] * Real(1 + 1e-5)) << "warp spring " << s;
-                } else {
-                    worst_layer2 = std::max(worst_layer2, length / warp->rest_m[s] - 1);
+                if (!classic && warp == &t.warp2 && garment.inv_mass[warp->a[s]] == 0) {
+                    worst_below_pins = std::max(worst_below_pins, length / warp->rest_m[s] - 1);
+                    continue;
                 }
+                ASSERT_LE(length, Real(1.10) * warp->rest_m[s] * Real(1 + 1e-5)) << "warp spring " << s;
+                if (warp == &t.warp2) ++layer2_checked;
             }
         }
         ++checks;
     });
     EXPECT_GT(checks, 100);
-    RecordProperty("worst_layer2_warp_strain", std::to_string(worst_layer2));
+    EXPECT_GT(layer2_checked, 10000u);
+    RecordProperty("worst_layer2_warp_strain_below_pins", std::to_string(worst_below_pins));
 }
 
 TEST_P(ConstraintOnWalkingSkirt, PinnedParticlesAreNeverMovedByTheConstraints) {

@@ -1,0 +1,144 @@
+// Layer-2 strain guarantees of the placement (method §4.2, weft.hpp), checked right after the
+// constraint system:
+// - every layer-2 warp spring whose upper end is free is at most 1.10 x rest;
+// - every weft segment beside a free layer-2 particle that does not hang from a pinned one is
+//   at most max(1.10 x the mean rest of its span, chord / weft_stride), the chord being the
+//   layer-1 edge the particle is placed on;
+// - the back-off (particles above going back onto their chords) restores the warp bound
+//   where no bulge could hold it.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "analytic_body.hpp"
+#include "systems/cloth/garment_builder.hpp"
+#include "systems/cloth/garment_step.hpp"
+#include "systems/cloth/substeps.hpp"
+#include "systems/cloth/weft.hpp"
+
+namespace drape {
+namespace {
+
+// Float rounding: relative, plus positions ~1 m from the origin carry ~1e-7 m of error each.
+constexpr Real tolerance = Real(1 + 1e-5);
+constexpr Real slack_m = Real(1e-6);
+constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+
+// Runs `frames` fixed steps, calling `after_constraints` after each constraint pass.
+template <class F>
+void walk(test::AnalyticBody& body, Registry& registry, Garment& g, int frames, F&& after_constraints) {
+    const double dt = 1.0 / 60.0;
+    for (int frame = 0; frame < frames; ++frame) {
+        body.place(registry, (frame + 1) * dt, false, dt);
+        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
+        FrameContext ctx;
+        ctx.fixed_dt_s = dt;
+        ctx.substeps = substeps;
+        ctx.h_s = dt / substeps;
+        for (int s = 0; s < substeps; ++s) {
+            ctx.substep = s;
+            integrate_garment(registry, g, ctx);
+            constrain_garment(g, ctx);
+            after_constraints(g);
+            collide_garment_step(registry, g, ctx);
+        }
+    }
+}
+
+// Counts of what was checked.
+struct Checked {
+    std::size_t warp = 0, weft = 0;
+};
+
+// Asserts both guarantees on the current positions; adds what it checked to `checked`.
+void expect_layer2_bounds(const Garment& g, Real limit, Checked& checked) {
+    const GarmentTopology& t = *g.topology;
+    const Real stretch = 1 + limit;
+    for (std::size_t s = 0; s < t.warp2.size(); ++s) {
+        if (g.inv_mass[t.warp2.a[s]] == 0) continue;  // hangs from the fitting zone
+        const Real length = (g.x.col(t.warp2.b[s]) - g.x.col(t.warp2.a[s])).norm();
+        ASSERT_LE(length, stretch * t.warp2.rest_m[s] * tolerance + slack_m) << "layer-2 warp spring " << s;
+        ++checked.warp;
+    }
+    // Placement entry of each layer-2 particle.
+    std::vector<std::size_t> entry(t.particle_count(), none);
+    for (std::size_t k = 0; k < t.weft_particle.size(); ++k) entry[t.weft_particle[k]] = k;
+    for (std::size_t s = 0; s < t.weft.size(); ++s) {
+        std::size_t k = none;
+        for (const std::uint32_t end : {t.weft.a[s], t.weft.b[s]})
+            if (entry[end] != none) k = entry[end];
+        if (k == none) continue;  // layer 1 to layer 1 (stride 1)
+        const std::uint32_t i = t.weft_particle[k], above = t.weft_above[k];
+        if (g.inv_mass[i] == 0 || (above != none && g.inv_mass[above] == 0)) continue;
+        const Real chord = (g.x.col(t.weft_right[k]) - g.x.col(t.weft_left[k])).norm();
+        const Real bound = std::max(stretch * t.weft_rest_m[k], chord / Real(t.weft_stride));
+        const Real length = (g.x.col(t.weft.b[s]) - g.x.col(t.weft.a[s])).norm();
+        ASSERT_LE(length, bound * tolerance + slack_m) << "weft segment " << s;
+        ++checked.weft;
+    }
+}
+
+TEST(StrainLayer2, WalkingSkirtHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem) {
+    Registry registry;
+    test::AnalyticBody body(registry);
+    const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
+    Garment& g = registry.get<Garment>(e);
+    Checked checked;
+    walk(body, registry, g, 150, [&](Garment& garment) { expect_layer2_bounds(garment, garment.material.strain_limit, checked); });
+    EXPECT_GT(checked.warp, 50000u);
+    EXPECT_GT(checked.weft, 100000u);
+}
+
+TEST(StrainLayer2, WalkingDressHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem) {
+    Registry registry;
+    test::AnalyticBody body(registry);
+    const Entity e = *attach_dress(registry, body.character, DressParams{});
+    Garment& g = registry.get<Garment>(e);
+    Checked checked;
+    walk(body, registry, g, 40, [&](Garment& garment) { expect_layer2_bounds(garment, garment.material.strain_limit, checked); });
+    EXPECT_GT(checked.warp, 200000u);
+}
+
+// A 4 x 4 hanging sheet (layer-1 lines 0 and 3, layer-2 lines 1 and 2), rests 0.1 m. Row 0
+// is pinned with its layer-2 particles 5 cm in front of their chords; layer 1 hangs straight
+// at 1.099 x rest. Row 1 can only reach near the pins with a bulge beyond the weft interval;
+// row 2 then has no bulge that holds both its warp spring and its weft segments, so row 1
+// must go back onto its chord.
+TEST(StrainLayer2, RowsAboveGoBackOntoTheirChordsWhereNoBulgeHoldsTheWarpSpring) {
+    RectangleParams params;
+    params.warp_lines = 4;
+    params.particles_per_line = 4;
+    params.width_m = Real(0.3);
+    params.length_m = Real(0.3);
+    Garment g = *make_rectangle(params);
+    const GarmentTopology& t = *g.topology;
+    const Vec3 origin = params.origin;
+    const Real drop = Real(0.1099);
+    for (std::uint32_t line = 0; line < 4; ++line)
+        for (std::uint32_t row = 0; row < 4; ++row) {
+            const std::uint32_t i = t.grid[line * 4 + row];
+            g.x.col(i) = origin + Vec3(Real(0.1) * Real(line), -drop * Real(row), 0);
+            if (row == 0 && t.layer[i] == 2) g.x(2, i) += Real(0.05);          // pinned, off its chord
+            if (row > 0 && t.layer[i] == 2) g.x(2, i) += Real(0.04);           // wants to follow
+        }
+    g.v.setZero();
+    prepare_garment(g);
+    compute_layer1_normals(t, g.x, g.normals);
+    place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, Real(0.01), Real(0.10));
+
+    Checked checked;
+    expect_layer2_bounds(g, Real(0.10), checked);
+    EXPECT_EQ(checked.warp, 4u);  // rows 1 -> 2 and 2 -> 3 on both layer-2 lines
+    for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+        const std::uint32_t i = t.weft_particle[k];
+        if (g.inv_mass[i] == 0) continue;
+        EXPECT_NEAR(weft_plane_distance(t, g.normals, g.x, k), 0, 1e-6) << "entry " << k;
+        if (k % 4 == 1) {  // row 1: back on its chord
+            const Vec3 chord = (1 - t.weft_t[k]) * g.x.col(t.weft_left[k]) + t.weft_t[k] * g.x.col(t.weft_right[k]);
+            EXPECT_LT((g.x.col(i) - chord).norm(), 1e-6) << "entry " << k;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace drape
