@@ -87,7 +87,7 @@ CLI::Validator integer_in(long long min, long long max) {
             if (ec != std::errc() || ptr != end || v < min || v > max) return "must be an integer in " + range + ", got " + text;
             return {};
         },
-        "INT in " + range);
+        range);
 }
 
 CLI::Validator number_in(double min, double max) {
@@ -100,7 +100,7 @@ CLI::Validator number_in(double min, double max) {
                 return "must be a number in " + range + ", got " + text;
             return {};
         },
-        "NUMBER in " + range);
+        range);
 }
 
 CLI::Validator one_of(std::vector<std::string> choices) {
@@ -112,7 +112,11 @@ CLI::Validator one_of(std::vector<std::string> choices) {
                 if (c == text) return {};
             return "must be one of " + list + ", got \"" + text + "\"";
         },
-        "one of " + list);
+        "{" + list + "}");
+}
+
+CLI::Validator not_empty() {
+    return CLI::Validator([](std::string& text) -> std::string { return text.empty() ? "must not be empty" : ""; }, "");
 }
 
 int run_command_line(CLI::App& app, int argc, const char* const* argv) {

@@ -38,6 +38,8 @@ inline constexpr int exit_bad_input = 1;
 [[nodiscard]] CLI::Validator number_in(double min, double max);
 /// One of `choices`: "--garment: must be one of skirt, dress, none, got \"hat\"".
 [[nodiscard]] CLI::Validator one_of(std::vector<std::string> choices);
+/// A file name, folder or clip that is not empty ("--scene \"$SCENE\"" with SCENE unset).
+[[nodiscard]] CLI::Validator not_empty();
 
 /// Parses and runs the command line. A command-line error is one line on stderr
 /// ("drape play: --frames: must be ...") and returns exit_bad_input; help returns 0.

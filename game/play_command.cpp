@@ -400,9 +400,9 @@ int play(const PlayOptions& o) {
 void add_play_command(CLI::App& app) {
     auto o = std::make_shared<PlayOptions>();
     CLI::App* play_app = app.add_subcommand("play", "Play a scene (default: the sample scene) and print the frame budget");
-    play_app->add_option("--scene", o->scene, "Scene file (JSON, see docs/scenes.md); default: the sample scene");
-    play_app->add_option("--character", o->character, "Character file (.glb/.gltf/.fbx/...) replacing the scene's first character");
-    play_app->add_option("--clip", o->clip, "Clip of the first character: name or index");
+    play_app->add_option("--scene", o->scene, "Scene file (JSON, see docs/scenes.md); default: the sample scene")->check(not_empty());
+    play_app->add_option("--character", o->character, "Character file (.glb/.gltf/.fbx/...) replacing the scene's first character")->check(not_empty());
+    play_app->add_option("--clip", o->clip, "Clip of the first character: name or index")->check(not_empty());
     play_app->add_option("--garment", o->garment, "Dress the first character in a default skirt or dress, or nothing")
         ->check(one_of({"skirt", "dress", "none"}));
     play_app->add_option("--model", o->model, "Garment model: the paper's simplified mass-spring or the classic baseline")
@@ -410,14 +410,14 @@ void add_play_command(CLI::App& app) {
     play_app->add_option("--frames", o->frames, "Frames to play (default 240; in a window: until closed)")
         ->check(integer_in(1, 10'000'000));
     play_app->add_flag("--headless", o->headless, "No rendering at all (no render system)");
-    play_app->add_option("--out", o->out, "Write every frame as PNG into this folder");
-    play_app->add_option("--video", o->video, "Write an H.264 video (frames piped to ffmpeg)");
+    play_app->add_option("--out", o->out, "Write every frame as PNG into this folder")->check(not_empty());
+    play_app->add_option("--video", o->video, "Write an H.264 video (frames piped to ffmpeg)")->check(not_empty());
     play_app->add_flag("--window", o->window, "Show the scene in an X11 window (mouse: orbit; keys: space, N, E, M, R, Q)");
-    play_app->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 1280x720)");
+    play_app->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 1280x720)")->check(not_empty());
     play_app->add_option("--fps", o->fps, "Frames per second of off-screen playback and video (default 60)")
         ->check(number_in(1, 1000));
-    play_app->add_option("--trace", o->trace, "Write Chrome trace event JSON (Perfetto, chrome://tracing)");
-    play_app->add_option("--stats", o->stats, "Write run statistics JSON (systems, garments)");
+    play_app->add_option("--trace", o->trace, "Write Chrome trace event JSON (Perfetto, chrome://tracing)")->check(not_empty());
+    play_app->add_option("--stats", o->stats, "Write run statistics JSON (systems, garments)")->check(not_empty());
     play_app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(integer_in(0, 1024));
     play_app->add_option("--time-scale", o->time_scale, "Simulated seconds per wall-clock second (slow motion < 1)")
         ->check(number_in(0, 1000));
