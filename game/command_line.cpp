@@ -42,6 +42,8 @@ std::string reword(const std::string& message) {
     if (std::regex_match(message, m, member))
         return m[1].str() + ": must be one of " + std::regex_replace(m[3].str(), std::regex(","), ", ") + ", got \"" + m[2].str() + "\"";
     if (std::regex_match(message, m, missing)) return m[1].str() + ": needs a value";
+    static const std::regex repeated(R"(^(\S+): At Most 1 required but received (\d+)$)");
+    if (std::regex_match(message, m, repeated)) return m[1].str() + ": given " + m[2].str() + " times; give it once";
     return message;
 }
 

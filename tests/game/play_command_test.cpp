@@ -100,6 +100,7 @@ TEST_F(PlayCommand, CommandLineErrorsAreOneLineWithTheSameExitCodeAsOtherBadInpu
         {"play --frames 2.5", "drape play: --frames: must be an integer in [1, 10000000], got 2.5\n"},
         {"play --frames", "drape play: --frames: needs a value\n"},
         {"play --scene ''", "drape play: --scene: must not be empty\n"},
+        {"play --frames 3 --frames 4", "drape play: --frames: given 2 times; give it once\n"},
         {"play --garment hat", "drape play: --garment: must be one of skirt, dress, none, got \"hat\"\n"},
         {"play --model fancy", "drape play: --model: must be one of simplified, classic, got \"fancy\"\n"},
         {"play --fps 0", "drape play: --fps: must be a number in [1, 1000], got 0\n"},
