@@ -14,6 +14,8 @@
 #include <tuple>
 #include <vector>
 
+#include <unistd.h>
+
 #include "game/commands.hpp"
 #include "game/output_files.hpp"
 #include "game/scene.hpp"
@@ -207,6 +209,8 @@ int play(const PlayOptions& o) {
         const fs::path folder = fs::path(file).parent_path();
         if (!folder.empty() && !fs::is_directory(folder, ec))
             return report(std::string(name) + ": folder " + folder.string() + " does not exist");
+        if (::access(folder.empty() ? "." : folder.c_str(), W_OK) != 0)
+            return report(std::string(name) + ": folder " + (folder.empty() ? std::string(".") : folder.string()) + " is not writable");
         if (auto ok = check_new_file(name, file, o.overwrite); !ok) return report(ok.error().message);
         for (std::size_t k = 0; k < i; ++k)
             if (!files[k].second.empty() && fs::path(files[k].second).lexically_normal() == fs::path(file).lexically_normal())
