@@ -462,8 +462,8 @@ void apply_root_correction(SkeletonAsset& skeleton, MeshAsset& mesh, std::vector
 // Zero-length bones in the rest (node) pose: a bone whose child joints all sit at its own
 // joint, or an end bone (no children) at its parent joint's place. Such a bone has no
 // direction, and when a whole chain is like that the rest pose folds the body up (a file
-// whose joints were all moved onto their parents plays a 1.75 m avatar 0.58 m tall): with
-// vertices skinned to it, an error. Without, it is an exporter's end marker (a leaf joint
+// whose joints were all moved onto their parents plays a 1.75 m avatar 0.58 m tall): for a
+// skin joint with vertices skinned to it, an error. Without, it is an exporter's end marker (a leaf joint
 // at its parent's place): a warning, and it does not make its parent zero-length.
 // Lengths are compared with the bind mesh's size, so the file's units do not matter.
 Result<void> check_bone_lengths(Builder& b, const MeshAsset& mesh) {
@@ -498,7 +498,8 @@ Result<void> check_bone_lengths(Builder& b, const MeshAsset& mesh) {
             if (b.has_bind[i] && ++marker_count <= 5) markers += (markers.empty() ? "'" : ", '") + s.bone_names[i] + "'";
             continue;
         }
-        if (weighted[i] == 0) continue;
+        // Only skin joints: a mesh bound rigidly to a scene node (weight 1 on it) needs no direction.
+        if (weighted[i] == 0 || !b.has_bind[i]) continue;
         bool end_bone = false;
         if (length[i] < 0) {  // no child joint that tells its length: the segment from its parent joint
             const int parent = s.parents[i];
