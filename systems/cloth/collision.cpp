@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "systems/cloth/body.hpp"
@@ -61,6 +62,161 @@ inline void for_each_bit(std::uint64_t bits, F&& f) {
         bits &= bits - 1;
         f(e);
     }
+}
+
+// ---- Candidate lists (method §5, spatial locality); see collision.hpp step 1.
+
+// An ellipsoid's bit is refreshed in every list once the ellipsoid has moved this share of
+// the margin since its reference pose; a particle's list is refreshed when its own move
+// plus the largest ellipsoid move exceeds its budget. docs/cloth.md has the measurements.
+constexpr Real ellipsoid_refresh_share = Real(0.5);
+// Particles per block in a bit refresh; a block whose bounding box is farther than the
+// margin from the ellipsoid's box is cleared without a test.
+constexpr Eigen::Index candidate_block = 32;
+// Clearances are lowered by this much so that float rounding cannot turn a bound into a miss.
+constexpr Real clearance_rounding_m = Real(1e-5);
+
+// An ellipsoid as the list tests see it: unit-sphere map and world box, in the frame of the
+// points it is tested against.
+struct ListEllipsoid {
+    Mat3 to_unit = Mat3::Identity();
+    Vec3 offset = Vec3::Zero();  ///< to_unit * centre.
+    Vec3 radii = Vec3::Ones();
+    Vec3 low = Vec3::Zero(), high = Vec3::Zero();
+
+    ListEllipsoid() = default;
+    explicit ListEllipsoid(const EllipsoidFrame& f)
+        : to_unit(f.to_unit), offset(f.to_unit * f.center), radii(f.radii_m) {
+        const Vec3 half = f.rotation.cwiseAbs() * f.radii_m;
+        low = f.center - half;
+        high = f.center + half;
+    }
+};
+
+// Lower bounds of the distances from points to an ellipsoid, from their unit-sphere
+// coordinates y (3 x k): the unit-sphere map stretches distances by at most 1 / r_min, and
+// the ellipsoid lies inside its box of half sizes r_i in its own axes. Negative inside.
+template <class Y>
+inline auto clearance_of(const Y& y, const Vec3& radii) {
+    const auto box = ((y.array().abs() - 1).colwise() * radii.array()).colwise().maxCoeff();
+    return (radii.minCoeff() * (y.colwise().norm().array() - 1)).max(box);
+}
+
+// Ellipsoids as structure of arrays, 8 to a chunk, to test one point against all of them
+// in a few vector instructions (a particle's whole list). Unused lanes hold an ellipsoid
+// 1e18 m away: never listed, never the nearest.
+class EllipsoidLanes {
+public:
+    void add(const ListEllipsoid& f, int e) {
+        const int chunk = m_count / width, lane = m_count % width;
+        if (lane == 0) m_chunks[static_cast<std::size_t>(chunk)] = Chunk{};
+        Chunk& c = m_chunks[static_cast<std::size_t>(chunk)];
+        for (int i = 0; i < 9; ++i) c.to_unit[static_cast<std::size_t>(i)][lane] = f.to_unit(i / 3, i % 3);
+        for (int i = 0; i < 3; ++i) {
+            c.offset[static_cast<std::size_t>(i)][lane] = f.offset[i];
+            c.radii[static_cast<std::size_t>(i)][lane] = f.radii[i];
+        }
+        c.r_min[lane] = f.radii.minCoeff();
+        c.bit[static_cast<std::size_t>(lane)] = std::uint64_t(1) << e;
+        ++m_count;
+    }
+    [[nodiscard]] bool empty() const noexcept { return m_count == 0; }
+
+    // Sets `bits` to the ellipsoids within `margin` of x; returns the smallest clearance
+    // (clearance_of) of the others.
+    Real test(const Vec3& x, Real margin, std::uint64_t& bits) const {
+        bits = 0;
+        Real nearest = std::numeric_limits<Real>::infinity();
+        for (int k = 0; k * width < m_count; ++k) {
+            const Chunk& c = m_chunks[static_cast<std::size_t>(k)];
+            const Lanes y0 = c.to_unit[0] * x[0] + c.to_unit[1] * x[1] + c.to_unit[2] * x[2] - c.offset[0];
+            const Lanes y1 = c.to_unit[3] * x[0] + c.to_unit[4] * x[1] + c.to_unit[5] * x[2] - c.offset[1];
+            const Lanes y2 = c.to_unit[6] * x[0] + c.to_unit[7] * x[1] + c.to_unit[8] * x[2] - c.offset[2];
+            const Lanes sphere = c.r_min * ((y0 * y0 + y1 * y1 + y2 * y2).sqrt() - 1);  // as clearance_of
+            const Lanes box0 = c.radii[0] * (y0.abs() - 1), box1 = c.radii[1] * (y1.abs() - 1), box2 = c.radii[2] * (y2.abs() - 1);
+            for (std::size_t l = 0; l < width; ++l) {
+                const int i = static_cast<int>(l);
+                const Real clearance = std::max(std::max(sphere[i], box0[i]), std::max(box1[i], box2[i]));
+                bits |= clearance <= margin ? c.bit[l] : 0;
+                nearest = std::min(nearest, clearance <= margin ? std::numeric_limits<Real>::infinity() : clearance);
+            }
+        }
+        return nearest;
+    }
+
+private:
+    static constexpr int width = 8;
+    using Lanes = Eigen::Array<Real, width, 1>;
+    struct Chunk {
+        std::array<Lanes, 9> to_unit{Lanes::Zero(), Lanes::Zero(), Lanes::Zero(), Lanes::Zero(), Lanes::Zero(),
+                                     Lanes::Zero(), Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
+        std::array<Lanes, 3> offset{Lanes::Constant(Real(-1e18)), Lanes::Zero(), Lanes::Zero()};
+        std::array<Lanes, 3> radii{Lanes::Ones(), Lanes::Ones(), Lanes::Ones()};
+        Lanes r_min = Lanes::Ones();
+        std::array<std::uint64_t, width> bit{};
+    };
+    std::array<Chunk, 64 / width> m_chunks;
+    int m_count = 0;
+};
+
+// Unit-sphere coordinates of a block of points (rows contiguous: whole-row arithmetic) and
+// one value per point.
+using BlockPoints = Eigen::Matrix<Real, 3, Eigen::Dynamic, 0, 3, candidate_block>;
+using BlockValues = Eigen::Array<Real, 1, Eigen::Dynamic, Eigen::RowMajor, 1, candidate_block>;
+
+// Bounding box of points.
+struct PointBounds {
+    Vec3 low = Vec3::Constant(std::numeric_limits<Real>::infinity());
+    Vec3 high = Vec3::Constant(-std::numeric_limits<Real>::infinity());
+    template <class X>
+    explicit PointBounds(const X& x) {
+        for (Eigen::Index i = 0; i < x.cols(); ++i) {
+            low = low.cwiseMin(x.col(i));
+            high = high.cwiseMax(x.col(i));
+        }
+    }
+    // Lower bound of the distance between a point inside and the ellipsoid `f`.
+    [[nodiscard]] Real gap(const ListEllipsoid& f) const { return (f.low - high).cwiseMax(low - f.high).maxCoeff(); }
+};
+
+// Refreshes bit e of the lists of points x (any frame; `f` and `bounds` in the same frame):
+// set where a point is within `margin` of the ellipsoid, cleared elsewhere. With `budget`,
+// lowers each unlisted point's budget to its clearance.
+std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const ListEllipsoid& f, std::size_t e,
+                          Real margin, std::vector<std::uint64_t>& candidates, VectorX* budget) {
+    const Eigen::Index n = x.cols();
+    const std::uint64_t bit = std::uint64_t(1) << e;
+    std::uint64_t* out = candidates.data();
+    Real* b = budget ? budget->data() : nullptr;
+    // Broad phase, whole garment then blocks: a gap between the boxes bounds every distance.
+    if (const Real gap = bounds.gap(f); gap > margin) {
+        for (Eigen::Index i = 0; i < n; ++i) out[i] &= ~bit;
+        if (b)
+            for (Eigen::Index i = 0; i < n; ++i) b[i] = std::min(b[i], gap - clearance_rounding_m);
+        return 0;
+    }
+    std::uint64_t tests = 0;
+    BlockPoints y;
+    BlockValues clearance;
+    for (Eigen::Index begin = 0; begin < n; begin += candidate_block) {
+        const Eigen::Index count = std::min<Eigen::Index>(candidate_block, n - begin);
+        const auto block = x.middleCols(begin, count);
+        if (const Real gap = PointBounds(block).gap(f); gap > margin) {
+            for (Eigen::Index i = begin; i < begin + count; ++i) out[i] &= ~bit;
+            if (b)
+                for (Eigen::Index i = begin; i < begin + count; ++i) b[i] = std::min(b[i], gap - clearance_rounding_m);
+            continue;
+        }
+        y.noalias() = f.to_unit * block;
+        y.colwise() -= f.offset;
+        clearance = clearance_of(y, f.radii);
+        for (Eigen::Index i = 0; i < count; ++i) out[begin + i] = clearance[i] <= margin ? out[begin + i] | bit : out[begin + i] & ~bit;
+        if (b)
+            for (Eigen::Index i = 0; i < count; ++i)
+                b[begin + i] = clearance[i] <= margin ? b[begin + i] : std::min(b[begin + i], clearance[i] - clearance_rounding_m);
+        tests += static_cast<std::uint64_t>(count);
+    }
+    return tests;
 }
 
 // Entry and exit distances of the ray o + t d (|d| = 1) through the ellipsoid; in > out if it misses.
@@ -174,39 +330,29 @@ std::uint64_t active_mask(std::span<const EllipsoidFrame> frames) {
     return mask;
 }
 
-std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
-                                    std::vector<std::uint64_t>& candidates, Matrix3X* scratch) {
-    const Eigen::Index n = x.cols();
-    candidates.assign(static_cast<std::size_t>(n), 0);
-    Matrix3X local_scratch;
-    Matrix3X& y = scratch ? *scratch : local_scratch;
-    y.resize(3, n);  // no allocation when the scratch is already sized
-    std::uint64_t tests = 0;
-    if (n == 0) return 0;
-    const Vec3 low = x.rowwise().minCoeff(), high = x.rowwise().maxCoeff();
-    for (std::size_t e = 0; e < frames.size() && e < 64; ++e) {
-        const EllipsoidFrame& f = frames[e];
-        if (!f.active) continue;
-        const Real reach = 1 + margin / f.radii_m.minCoeff();
-        const Real reach_sq = reach * reach;
-        // The reach region's bounding box misses the garment's: no particle can list it.
-        const Vec3 half = reach * (f.rotation * f.radii_m.asDiagonal()).rowwise().norm();
-        if (((f.center - half).array() > high.array()).any() || ((f.center + half).array() < low.array()).any()) continue;
-        const std::uint64_t bit = std::uint64_t(1) << e;
-        // Whole-array unit-sphere map, then one compare per particle.
-        y.noalias() = f.to_unit * x;
-        const Vec3 offset = f.to_unit * f.center;
-        for (Eigen::Index p = 0; p < n; ++p)
-            if ((y.col(p) - offset).squaredNorm() <= reach_sq) candidates[static_cast<std::size_t>(p)] |= bit;
-        tests += static_cast<std::uint64_t>(n);
+std::uint64_t refresh_candidate_bit(const Matrix3X& x, std::span<const EllipsoidFrame> frames, std::size_t e,
+                                    Real margin, std::vector<std::uint64_t>& candidates) {
+    candidates.resize(static_cast<std::size_t>(x.cols()), 0);
+    if (e >= 64) return 0;
+    if (e >= frames.size() || !frames[e].active) {
+        for (std::uint64_t& c : candidates) c &= ~(std::uint64_t(1) << e);
+        return 0;
     }
+    return refresh_bit(x, PointBounds(x), ListEllipsoid(frames[e]), e, margin, candidates, nullptr);
+}
+
+std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
+                                    std::vector<std::uint64_t>& candidates) {
+    candidates.assign(static_cast<std::size_t>(x.cols()), 0);
+    std::uint64_t tests = 0;
+    for (std::size_t e = 0; e < frames.size() && e < 64; ++e) tests += refresh_candidate_bit(x, frames, e, margin, candidates);
     return tests;
 }
 
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected,
-                                  const Matrix3X* x_start, Real h, Real list_slack) {
+                                  const Matrix3X* x_start, Real h, std::span<const Real> list_slack) {
     CollisionResult r;
     const Eigen::Index n = x.cols();
     last_collided.resize(static_cast<std::size_t>(n), 0);
@@ -253,7 +399,8 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         for_each_bit(hits & last, respond);
         for_each_bit(hits & ~last, respond);
         // Pushed beyond what the list still covers: every ellipsoid may now be near.
-        const Real slack_sq = list_slack * list_slack;
+        const Real slack = list_slack.size() == static_cast<std::size_t>(n) ? list_slack[pi] : std::numeric_limits<Real>::infinity();
+        const Real slack_sq = slack * slack;
         std::uint64_t retest = (xp - x_detected).squaredNorm() > slack_sq ? active : list;
         if (std::popcount(retest) > 1 || retest != list) {
             bool moved = true;
@@ -306,86 +453,125 @@ DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass, std
     return out;
 }
 
-CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
-    const Eigen::Index n = g.x.cols();
-    const std::size_t e_count = g.frames.size();
-    const std::vector<std::uint64_t>* lists = nullptr;
-    Real slack = std::numeric_limits<Real>::infinity();
+namespace {
 
-    if (g.collision == CollisionMode::candidate_lists) {
-        const Affine3 anchor = anchor_frame(g);
-        const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
-        const Vec3 anchor_origin = anchor.translation();
-        const Real margin = g.material.candidate_margin_m;
-        bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
-                     g.candidates.size() == static_cast<std::size_t>(n) && g.list_epoch_move.size() == static_cast<std::size_t>(n);
-        Real frame_move = 0;
-        for (std::size_t e = 0; valid && e < e_count; ++e) {
-            const Affine3& then = g.list_anchor_frames[e];
-            const bool was_active = then.linear().squaredNorm() > 0;
-            if (was_active != g.frames[e].active) { valid = false; break; }
-            if (!was_active) continue;
-            const Affine3 world = unit_to_world(g.frames[e]);
-            const Vec3 c = to_anchor * (world.translation() - anchor_origin);
-            const Mat3 l = to_anchor * world.linear();
-            frame_move = std::max(frame_move, (c - then.translation()).norm() + (l - then.linear()).norm());
-        }
-        // A global rebuild (new epoch) once the ellipsoids have used half the margin.
-        if (valid && frame_move > margin / 2) valid = false;
-        if (!valid) {
-            const std::uint64_t tests = build_candidate_lists(g.x, g.frames, margin, g.candidates, &g.force);
-            g.list_anchor_x.resize(3, n);
-            for (Eigen::Index p = 0; p < n; ++p) g.list_anchor_x.col(p) = to_anchor * (g.x.col(p) - anchor_origin);
-            g.list_epoch_move.assign(static_cast<std::size_t>(n), 0);
-            g.list_anchor_frames.resize(e_count);
-            for (std::size_t e = 0; e < e_count; ++e) {
-                Affine3& then = g.list_anchor_frames[e];
-                if (!g.frames[e].active) {
-                    then.matrix().setZero();
-                    continue;
-                }
-                const Affine3 world = unit_to_world(g.frames[e]);
-                then.setIdentity();
-                then.linear() = to_anchor * world.linear();
-                then.translation() = to_anchor * (world.translation() - anchor_origin);
+// A collider in the anchor's frame (rigid, so distances hold), as a frame for the list tests.
+EllipsoidFrame in_anchor_frame(const EllipsoidFrame& f, const Affine3& anchor) {
+    EllipsoidFrame a;
+    a.rotation = anchor.linear().transpose() * f.rotation;
+    a.center = anchor.linear().transpose() * (f.center - anchor.translation());
+    a.radii_m = f.radii_m;
+    a.to_unit = f.to_unit * anchor.linear();
+    a.active = f.active;
+    return a;
+}
+
+// Unit sphere -> frame map of an ellipsoid frame.
+Affine3 unit_map(const EllipsoidFrame& f) {
+    Affine3 t = Affine3::Identity();
+    t.linear() = f.rotation * f.radii_m.asDiagonal();
+    t.translation() = f.center;
+    return t;
+}
+
+// How far any point of the ellipsoid `then` can be from its image in `now`: |dc| + |dL|_F
+// (|dL u| <= |dL|_F for |u| <= 1).
+Real ellipsoid_move(const Affine3& now, const Affine3& then) {
+    return (now.translation() - then.translation()).norm() + (now.linear() - then.linear()).norm();
+}
+
+// An inactive collider's reference is a zero map.
+bool has_reference(const Affine3& t) { return t.linear().squaredNorm() > 0; }
+
+}  // namespace
+
+void update_candidate_lists(Garment& g) {
+    const Eigen::Index n = g.x.cols();
+    const std::size_t e_count = std::min<std::size_t>(g.frames.size(), 64);
+    const Affine3 anchor = anchor_frame(g);
+    const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
+    const Real margin = g.material.candidate_margin_m;
+    VectorX& budget = g.list_budget_m;
+    VectorX& slack = g.list_slack_m;
+    std::uint64_t tests = 0;
+
+    // 1. Each particle's position and move d_p in the anchor frame (whole arrays).
+    Matrix3X& local = g.list_scratch;
+    local.resize(3, n);
+    local.noalias() = to_anchor * g.x;
+    local.colwise() -= to_anchor * anchor.translation();
+    const bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
+                       budget.size() == n && g.candidates.size() == static_cast<std::size_t>(n);
+    if (!valid) {  // everything from scratch: every particle and every ellipsoid is its own reference
+        g.candidates.assign(static_cast<std::size_t>(n), 0);
+        g.list_anchor_x = local;
+        g.list_anchor_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
+        budget.setConstant(n, std::numeric_limits<Real>::infinity());
+        ++g.counters.list_rebuilds;
+    }
+    slack.resize(n);
+    slack = (local - g.list_anchor_x).colwise().norm().transpose();
+
+    // 2. Ellipsoids: refresh bit e against the particles' reference points when e has moved
+    //    its share since its reference pose, which it then becomes. D = largest move left.
+    std::optional<PointBounds> bounds;  // of the reference points, on first use
+    const Real ellipsoid_limit = ellipsoid_refresh_share * margin;
+    Real frame_move = 0;
+    for (std::size_t e = 0; e < e_count; ++e) {
+        Affine3& then = g.list_anchor_frames[e];
+        if (!g.frames[e].active) {
+            if (has_reference(then)) {
+                tests += refresh_candidate_bit(g.list_anchor_x, g.frames, e, margin, g.candidates);  // clears it
+                then.matrix().setZero();
             }
-            g.lists_valid = true;
-            frame_move = 0;
-            ++g.counters.list_rebuilds;
-            g.counters.list_rebuild_tests += tests;
-            g.counters.frame_list_rebuild_tests += tests;
+            continue;
         }
-        // Per particle: its list, built when the ellipsoids had moved epoch_move since the
-        // epoch, stays exact while its own move + epoch_move + frame_move <= margin.
-        // A particle past that bound gets a fresh list on its own.
-        slack = margin;
-        std::uint64_t particle_tests = 0;
-        const std::uint64_t active = active_mask(g.frames);
-        const int active_count = std::popcount(active);
-        for (Eigen::Index p = 0; p < n; ++p) {
-            const std::size_t pi = static_cast<std::size_t>(p);
-            const Vec3 local = to_anchor * (g.x.col(p) - anchor_origin);
-            Real room = margin - frame_move - g.list_epoch_move[pi] - (local - g.list_anchor_x.col(p)).norm();
-            if (room < 0) {
-                std::uint64_t bits = 0;
-                for_each_bit(active, [&](int e) {
-                    const EllipsoidFrame& f = g.frames[static_cast<std::size_t>(e)];
-                    const Real reach = 1 + margin / f.radii_m.minCoeff();
-                    if (to_unit_sphere(f, g.x.col(p)).squaredNorm() <= reach * reach) bits |= std::uint64_t(1) << e;
-                });
-                g.candidates[pi] = bits;
-                g.list_anchor_x.col(p) = local;
-                g.list_epoch_move[pi] = frame_move;
-                particle_tests += static_cast<std::uint64_t>(active_count);
-                room = margin - 2 * frame_move;
-            }
-            slack = std::min(slack, room);
+        const EllipsoidFrame current = in_anchor_frame(g.frames[e], anchor);
+        const Affine3 now = unit_map(current);
+        const Real moved = has_reference(then) ? ellipsoid_move(now, then) : std::numeric_limits<Real>::infinity();
+        if (moved <= ellipsoid_limit) {
+            frame_move = std::max(frame_move, moved);
+            continue;
         }
-        g.counters.list_rebuild_tests += particle_tests;
-        g.counters.frame_list_rebuild_tests += particle_tests;
-        lists = &g.candidates;
+        if (!bounds) bounds.emplace(g.list_anchor_x);
+        tests += refresh_bit(g.list_anchor_x, *bounds, ListEllipsoid(current), e, margin, g.candidates, &budget);
+        then = now;
     }
 
+    // 3. Particles: a list is exact while d_p + D <= budget_p, the clearance of the
+    //    reference point from the nearest unlisted reference ellipsoid. A particle past it
+    //    becomes its own reference and is tested against every reference ellipsoid.
+    const std::uint64_t active = active_mask(g.frames);
+    slack.array() = budget.array() - slack.array() - frame_move;
+    EllipsoidLanes references;  // filled on first use
+    for (Eigen::Index p = 0; p < n; ++p) {
+        if (slack[p] >= 0 || g.inv_mass[p] == 0) continue;  // pinned: never tested (method §3.5)
+        if (references.empty()) {
+            for_each_bit(active, [&](int e) {
+                references.add(ListEllipsoid(make_ellipsoid_frame(g.list_anchor_frames[static_cast<std::size_t>(e)])), e);
+            });
+        }
+        g.list_anchor_x.col(p) = local.col(p);
+        std::uint64_t bits = 0;
+        budget[p] = references.test(local.col(p), margin, bits) - clearance_rounding_m;
+        g.candidates[static_cast<std::size_t>(p)] = bits;
+        slack[p] = std::max(Real(0), budget[p] - frame_move);
+        tests += static_cast<std::uint64_t>(std::popcount(active));
+    }
+    g.lists_valid = true;
+    g.counters.list_rebuild_tests += tests;
+    g.counters.frame_list_rebuild_tests += tests;
+}
+
+CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
+    const Eigen::Index n = g.x.cols();
+    const std::vector<std::uint64_t>* lists = nullptr;
+    std::span<const Real> slack;
+    if (g.collision == CollisionMode::candidate_lists) {
+        update_candidate_lists(g);
+        lists = &g.candidates;
+        slack = std::span<const Real>(g.list_slack_m.data(), static_cast<std::size_t>(g.list_slack_m.size()));
+    }
     const bool have_start = h > 0 && g.x_start.cols() == n;
     const CollisionResult r = collide_particles(g.x, g.v, g.inv_mass, g.frames, lists, g.last_collided, detected,
                                                 have_start ? &g.x_start : nullptr, h, slack);

@@ -5,12 +5,19 @@
 //
 // Step order of one substep (cloth collision system):
 //   1. Candidate lists (spatial locality): each particle keeps a bit set of the ellipsoids
-//      it can touch. A list holds every ellipsoid within `margin` of the particle when it
-//      was built (|y| < 1 + margin / r_min). The lists stay exact while
-//      max particle displacement + max ellipsoid displacement <= margin, both measured in
-//      the anchor's rigid frame since the build (an ellipsoid's displacement is bounded by
-//      |dc| + |dL|_F of its unit-sphere map), so they are rebuilt only when that bound is
-//      spent. Within that bound no ellipsoid outside a list can contain the particle.
+//      it can touch: bit e is set when the particle is within `margin` of ellipsoid e,
+//      judged by a lower bound of the distance (clearance) that needs no root finding:
+//      max(r_min (|y| - 1), max_i r_i (|y_i| - 1)). Everything is measured in the anchor's
+//      rigid frame against references: each particle's position when its whole list was
+//      last refreshed (its move since: d_p) and each ellipsoid's pose when its bit was last
+//      refreshed (its move since, D_e <= |dc| + |dL|_F of its unit-sphere map). A
+//      particle's budget is the clearance of its reference point from the nearest unlisted
+//      reference ellipsoid; while d_p + max_e D_e <= budget no unlisted ellipsoid can
+//      contain it. An ellipsoid that has moved half the margin gets its bit refreshed in
+//      every list (a fast shin often, the pelvis rarely; blocks of particles whose box is
+//      far from it are cleared untested), which can only lower budgets; a particle whose
+//      budget is spent gets its whole list refreshed. What is left of the budget is the
+//      particle's slack for step 3.
 //   2. Detection: ellipsoids the particle collided with last substep are tested first
 //      (temporal coherence), then the rest of its list; brute force tests every ellipsoid.
 //   3. Response for each hit, last-collided first: move the particle to where the line
@@ -51,10 +58,23 @@ void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v);
 /// Bit set of the active frames.
 [[nodiscard]] std::uint64_t active_mask(std::span<const EllipsoidFrame> frames);
 
-/// Rebuilds every particle's candidate list (step 1). Returns the tests done. `scratch`
-/// (3 x particles, reused between calls) avoids an allocation.
+/// Sets bit `e` of every particle's candidate list when the particle is within `margin_m`
+/// of ellipsoid e (see step 1) and clears it otherwise; an inactive or missing ellipsoid
+/// clears it everywhere. Other bits are kept. Returns the tests done: blocks of particles
+/// whose bounding box misses the ellipsoid's reach are cleared untested.
+std::uint64_t refresh_candidate_bit(const Matrix3X& x, std::span<const EllipsoidFrame> frames, std::size_t e,
+                                    Real margin_m, std::vector<std::uint64_t>& candidates);
+
+/// Rebuilds every particle's candidate list from scratch (every bit). Returns the tests done.
 std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin_m,
-                                    std::vector<std::uint64_t>& candidates, Matrix3X* scratch = nullptr);
+                                    std::vector<std::uint64_t>& candidates);
+
+/// Step 1 for a garment: brings its candidate lists up to date for its current positions
+/// and frames (everything when `lists_valid` is false or the sizes changed, else the bits
+/// of ellipsoids and the lists of particles whose bound is spent), adds the tests to its
+/// counters and leaves in `list_slack_m` how far each free particle may still move before
+/// its list could miss an ellipsoid (>= 0).
+void update_candidate_lists(Garment& garment);
 
 /// What a collision pass did.
 struct CollisionResult {
@@ -71,19 +91,20 @@ using DetectedPairs = std::vector<std::uint64_t>;
 /// Steps 2-3 for particles [0, cols). `candidates` null = brute force. `last_collided`
 /// is read (tested first) and rewritten. With `x_start` (positions at the start of the
 /// substep of length h_s), a colliding particle's velocity is recomputed from its move.
-/// `list_slack_m`: how far a particle may still move before its list could miss an
-/// ellipsoid; a particle pushed farther is re-tested against every ellipsoid.
+/// `list_slack_m` (per particle; empty = unlimited): how far a particle may still move
+/// before its list could miss an ellipsoid; a particle pushed farther is re-tested against
+/// every ellipsoid.
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr,
                                   const Matrix3X* x_start = nullptr, Real h_s = 0,
-                                  Real list_slack_m = std::numeric_limits<Real>::infinity());
+                                  std::span<const Real> list_slack_m = {});
 
 /// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
 [[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,
                                                std::span<const EllipsoidFrame> frames);
 
-/// Whole garment: checks the lists' displacement bound (rebuilding when spent), then
+/// Whole garment: brings the lists up to date (update_candidate_lists) in list mode, then
 /// collides in the garment's mode and adds to its counters. Frames must be current.
 /// h_s > 0: velocities of colliding particles from their move since `garment.x_start`.
 CollisionResult collide_garment(Garment& garment, DetectedPairs* detected = nullptr, Real h_s = 0);

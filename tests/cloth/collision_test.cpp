@@ -1,8 +1,11 @@
-// Ellipsoid collision (method §5): response geometry, no particle left inside, and the
-// candidate lists + temporal coherence finding exactly what brute force finds.
+// Ellipsoid collision (method §5): response geometry, no particle left inside, the
+// candidate-list refresh, and the candidate lists + temporal coherence finding exactly what
+// brute force finds (skirt and dress, normal and fast walks).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <bit>
+#include <functional>
 
 #include "analytic_body.hpp"
 #include "systems/cloth/body.hpp"
@@ -72,16 +75,45 @@ TEST(Collision, OverlappingEllipsoidsLeaveNoParticleInside) {
         for (const EllipsoidFrame& f : frames) ASSERT_LE(penetration_depth(f, x.col(p)), 1e-5) << "particle " << p;
 }
 
-// Walks a skirt through a whole walk cycle, calling `check` around every collision pass.
-template <class F>
-void walk_cycle(ClothModel model, CollisionMode mode, F&& check) {
-    Registry registry;
-    test::WalkSettings walk;
-    test::AnalyticBody body(registry, walk);
+// Attaches a garment to the analytic body's character.
+using Dress = std::function<Entity(Registry&, Entity character, ClothModel, CollisionMode)>;
+
+Entity default_skirt(Registry& registry, Entity character, ClothModel model, CollisionMode mode) {
     SkirtParams params;
     params.model = model;
     params.collision = mode;
-    const Entity e = *attach_skirt(registry, body.character, params);
+    return *attach_skirt(registry, character, params);
+}
+
+// A 2,520-particle dress (the default's layout at half the resolution: the test stays quick).
+Entity small_dress(Registry& registry, Entity character, ClothModel model, CollisionMode mode) {
+    DressParams params;
+    params.warp_lines = 60;
+    params.particles_per_line = 42;
+    params.model = model;
+    params.collision = mode;
+    return *attach_dress(registry, character, params);
+}
+
+// A walk twice as fast with wider swings: a shin or a hand moves well past half the margin
+// in one step relative to the pelvis.
+test::WalkSettings fast_walk() {
+    test::WalkSettings walk;
+    walk.period_s = 0.55;
+    walk.hip_swing_rad = 0.7;
+    walk.knee_bend_rad = 1.1;
+    walk.forward_speed_m_s = 3.0;
+    walk.yaw_rad = 0.25;
+    return walk;
+}
+
+// Walks a garment through a whole walk cycle, calling `check` around every collision pass.
+template <class F>
+void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dress = default_skirt,
+                test::WalkSettings walk = {}) {
+    Registry registry;
+    test::AnalyticBody body(registry, walk);
+    const Entity e = dress(registry, body.character, model, mode);
     Garment& g = registry.get<Garment>(e);
     const double dt = 1.0 / 60.0;
     const int frames = static_cast<int>(walk.period_s / dt) + 1;
@@ -105,6 +137,137 @@ void walk_cycle(ClothModel model, CollisionMode mode, F&& check) {
     }
 }
 
+// Detection with lists + last-collided first, compared pair for pair with brute force on
+// identical positions before every collision pass. Returns {contacts, list tests, brute tests}.
+std::array<std::uint64_t, 3> compare_with_brute_force(ClothModel model, const Dress& dress, test::WalkSettings walk) {
+    std::uint64_t contacts = 0, list_tests = 0, brute_tests = 0;
+    walk_cycle(
+        model, CollisionMode::candidate_lists,
+        [&](Garment& g, bool before) {
+            if (!before) return;
+            const DetectedPairs expected = detect_brute_force(g.x, g.inv_mass, g.frames);
+            Garment copy = g;
+            DetectedPairs found;
+            const std::uint64_t tests_before = copy.counters.collision_tests;
+            collide_garment(copy, &found);
+            ASSERT_EQ(found.size(), expected.size());
+            for (std::size_t p = 0; p < found.size(); ++p) ASSERT_EQ(found[p], expected[p]) << "particle " << p;
+            for (std::uint64_t bits : expected) contacts += static_cast<std::uint64_t>(std::popcount(bits));
+            list_tests += copy.counters.collision_tests - tests_before;
+            brute_tests += static_cast<std::uint64_t>(g.x.cols()) * g.frames.size();
+        },
+        dress, walk);
+    return {contacts, list_tests, brute_tests};
+}
+
+TEST(CandidateLists, ARefreshedBitHoldsEveryPointWithinTheMarginAndOnlyItsBitChanges) {
+    const EllipsoidFrame f = tilted_ellipsoid();
+    const std::vector<EllipsoidFrame> frames = {tilted_ellipsoid(), f};  // refresh bit 1
+    const Real margin = Real(0.08);
+    std::uint32_t state = 7;
+    auto uniform = [&] {
+        state = state * 1664525u + 1013904223u;
+        return Real(state >> 8) / Real(1 << 24);
+    };
+    const int n = 3000;
+    Matrix3X x(3, n);
+    std::vector<Real> offset(n);  // distance outside the surface along its normal; < margin for the first half
+    for (int p = 0; p < n; ++p) {
+        Vec3 u(uniform() - Real(0.5), uniform() - Real(0.5), uniform() - Real(0.5));
+        u.normalize();
+        const Vec3 surface = f.center + f.rotation * f.radii_m.cwiseProduct(u);
+        const Vec3 normal = (f.to_unit.transpose() * u).normalized();
+        offset[std::size_t(p)] = p < n / 2 ? margin * uniform() * Real(0.999) : margin + Real(0.5) * uniform();
+        x.col(p) = surface + offset[std::size_t(p)] * normal;
+    }
+    std::vector<std::uint64_t> candidates(n);
+    for (int p = 0; p < n; ++p) candidates[std::size_t(p)] = (p % 3 == 0 ? 0b1u : 0u) | (p % 2 == 0 ? 0b10u : 0u) | 0b100u;
+    const std::vector<std::uint64_t> before = candidates;
+    EXPECT_GT(refresh_candidate_bit(x, frames, 1, margin, candidates), 0u);
+    int cleared = 0;
+    for (int p = 0; p < n; ++p) {
+        const std::size_t i = std::size_t(p);
+        EXPECT_EQ(candidates[i] & ~std::uint64_t(0b10), before[i] & ~std::uint64_t(0b10)) << "point " << p;  // others kept
+        if (p < n / 2) {
+            EXPECT_TRUE(candidates[i] & 0b10) << "point " << p << " is " << offset[i] << " m outside";
+        }
+        // Beyond the margin on one of its own axes the point cannot be within the margin.
+        const Vec3 local = f.rotation.transpose() * (x.col(p) - f.center);
+        if (((local.cwiseAbs() - f.radii_m).array() > margin).any()) {
+            EXPECT_FALSE(candidates[i] & 0b10) << "point " << p;
+        }
+        cleared += (candidates[i] & 0b10) == 0;
+    }
+    EXPECT_GT(cleared, n / 4);  // the far half is mostly left out
+
+    // An inactive ellipsoid: the bit is cleared everywhere, without a test.
+    std::vector<EllipsoidFrame> gone = frames;
+    gone[1].active = false;
+    EXPECT_EQ(refresh_candidate_bit(x, gone, 1, margin, candidates), 0u);
+    for (int p = 0; p < n; ++p) EXPECT_EQ(candidates[std::size_t(p)], before[std::size_t(p)] & ~std::uint64_t(0b10));
+}
+
+TEST(CandidateLists, OnASphereTheListIsExactlyTheMarginShell) {
+    // For a sphere the clearance bound is the distance itself: listed <=> |x - c| - r <= margin.
+    Affine3 t = Affine3::Identity();
+    t.translate(Vec3(0.1f, 1.0f, 0.2f));
+    t.scale(Real(0.15));
+    const std::vector<EllipsoidFrame> frames = {make_ellipsoid_frame(t)};
+    const Real margin = Real(0.08);
+    Matrix3X x(3, 200);
+    for (int p = 0; p < 200; ++p) {
+        const Real distance = Real(0.15) + Real(0.0013) * Real(p) - Real(0.05);  // -0.05 .. 0.21 m from the surface
+        x.col(p) = frames[0].center + distance * Vec3(1, 2, -2).normalized();
+    }
+    std::vector<std::uint64_t> candidates;
+    build_candidate_lists(x, frames, margin, candidates);
+    for (int p = 0; p < 200; ++p) {
+        const Real gap = (x.col(p) - frames[0].center).norm() - Real(0.15);
+        if (std::abs(gap - margin) < Real(1e-5)) continue;  // float rounding at the boundary
+        EXPECT_EQ(candidates[std::size_t(p)] == 1, gap <= margin) << "gap " << gap;
+    }
+}
+
+TEST(CandidateLists, OnlyTheEllipsoidsThatMovedAreRefreshed) {
+    // A skirt on a motionless body: after the first build nothing is refreshed. Then one
+    // forearm (far below the waist, beside the hips) swings by more than half the margin:
+    // only its bit is refreshed, and blocks of particles far from it are not even tested.
+    Registry registry;
+    test::WalkSettings still;
+    still.hip_swing_rad = still.knee_bend_rad = still.forward_speed_m_s = still.yaw_rad = 0;
+    test::AnalyticBody body(registry, still);
+    const Entity e = default_skirt(registry, body.character, ClothModel::simplified, CollisionMode::candidate_lists);
+    Garment& g = registry.get<Garment>(e);
+    update_frames(registry, g, 1);
+    g.lists_valid = false;
+    update_candidate_lists(g);
+    const std::uint64_t rebuilds = g.counters.list_rebuilds;
+    const std::uint64_t full = g.counters.list_rebuild_tests;
+    EXPECT_GT(full, 0u);
+    update_candidate_lists(g);
+    EXPECT_EQ(g.counters.list_rebuild_tests, full);  // nothing moved: nothing refreshed
+
+    const Entity forearm_entity = body.colliders[6];  // analytic body: left forearm
+    std::size_t forearm = 0;
+    while (forearm < g.colliders.size() && g.colliders[forearm] != forearm_entity) ++forearm;
+    ASSERT_LT(forearm, g.colliders.size());
+    auto& c = registry.get<EllipsoidCollider>(forearm_entity);
+    c.world.translation() += Vec3(0, 0, Real(0.06));  // 6 cm > margin / 2 = 4 cm
+    update_frames(registry, g, 1);
+    const std::vector<std::uint64_t> lists = g.candidates;
+    update_candidate_lists(g);
+    EXPECT_EQ(g.counters.list_rebuilds, rebuilds);                                    // no full rebuild
+    EXPECT_LT(g.counters.list_rebuild_tests - full, static_cast<std::uint64_t>(g.x.cols()));  // part of one bit
+    const std::uint64_t others = ~(std::uint64_t(1) << forearm);
+    for (std::size_t p = 0; p < lists.size(); ++p) EXPECT_EQ(g.candidates[p] & others, lists[p] & others);
+    // And the lists still find exactly what brute force finds.
+    const DetectedPairs expected = detect_brute_force(g.x, g.inv_mass, g.frames);
+    DetectedPairs found;
+    Garment copy = g;
+    collide_garment(copy, &found);
+    EXPECT_EQ(found, expected);
+}
+
 class CollisionOnWalk : public ::testing::TestWithParam<ClothModel> {};
 
 TEST_P(CollisionOnWalk, NoFreeParticleInsideAnyEllipsoidAfterCollision) {
@@ -125,23 +288,62 @@ TEST_P(CollisionOnWalk, NoFreeParticleInsideAnyEllipsoidAfterCollision) {
 }
 
 TEST_P(CollisionOnWalk, CandidateListsAndTemporalCoherenceFindExactlyWhatBruteForceFinds) {
-    std::uint64_t contacts = 0, list_tests = 0, brute_tests = 0;
-    // Detection as collide_garment does it, compared pair for pair on identical positions.
-    walk_cycle(GetParam(), CollisionMode::candidate_lists, [&](Garment& g, bool before) {
-        if (!before) return;
-        const DetectedPairs expected = detect_brute_force(g.x, g.inv_mass, g.frames);
-        Garment copy = g;
-        DetectedPairs found;
-        const std::uint64_t tests_before = copy.counters.collision_tests;
-        collide_garment(copy, &found);
-        ASSERT_EQ(found.size(), expected.size());
-        for (std::size_t p = 0; p < found.size(); ++p) ASSERT_EQ(found[p], expected[p]) << "particle " << p;
-        for (std::uint64_t bits : expected) contacts += static_cast<std::uint64_t>(std::popcount(bits));
-        list_tests += copy.counters.collision_tests - tests_before;
-        brute_tests += static_cast<std::uint64_t>(g.x.cols()) * g.frames.size();
-    });
-    EXPECT_GT(contacts, 1000u);      // the cycle really collides
+    const auto [contacts, list_tests, brute_tests] = compare_with_brute_force(GetParam(), default_skirt, {});
+    EXPECT_GT(contacts, 1000u);              // the cycle really collides
     EXPECT_LT(list_tests, brute_tests / 2);  // and the lists really prune
+}
+
+TEST_P(CollisionOnWalk, CandidateListsStayExactOnAFastWalk) {
+    const auto [contacts, list_tests, brute_tests] = compare_with_brute_force(GetParam(), default_skirt, fast_walk());
+    EXPECT_GT(contacts, 1000u);
+    EXPECT_LT(list_tests, brute_tests / 2);
+}
+
+TEST_P(CollisionOnWalk, CandidateListsStayExactOnADress) {
+    const auto [contacts, list_tests, brute_tests] = compare_with_brute_force(GetParam(), small_dress, {});
+    EXPECT_GT(contacts, 1000u);
+    EXPECT_LT(list_tests, brute_tests / 2);
+}
+
+TEST_P(CollisionOnWalk, AParticleMovedByItsSlackStaysOutOfEveryEllipsoidItsListLeavesOut) {
+    // The slack is what the list bound still covers: within it, no unlisted ellipsoid can
+    // be reached, in any direction (14 directions tried, plus straight at each ellipsoid).
+    std::array<Vec3, 14> directions;
+    std::size_t k = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        directions[k++] = Vec3::Unit(axis);
+        directions[k++] = -Vec3::Unit(axis);
+    }
+    for (int sx = -1; sx <= 1; sx += 2)
+        for (int sy = -1; sy <= 1; sy += 2)
+            for (int sz = -1; sz <= 1; sz += 2) directions[k++] = Vec3(Real(sx), Real(sy), Real(sz)).normalized();
+    std::uint64_t checked = 0;
+    walk_cycle(
+        GetParam(), CollisionMode::candidate_lists,
+        [&](Garment& g, bool before) {
+            if (!before) return;
+            Garment copy = g;
+            update_candidate_lists(copy);
+            ASSERT_EQ(copy.list_slack_m.size(), copy.x.cols());
+            for (Eigen::Index p = 0; p < copy.x.cols(); ++p) {
+                if (copy.inv_mass[p] == 0) continue;
+                const Real slack = copy.list_slack_m[p];
+                ASSERT_GE(slack, 0) << "particle " << p;
+                const std::uint64_t unlisted = active_mask(copy.frames) & ~copy.candidates[static_cast<std::size_t>(p)];
+                for (std::size_t e = 0; e < copy.frames.size(); ++e) {
+                    if (!(unlisted >> e & 1)) continue;
+                    const EllipsoidFrame& f = copy.frames[e];
+                    const Vec3 x = copy.x.col(p);
+                    const Vec3 toward = (f.center - x).normalized();
+                    ASSERT_GE(to_unit_sphere(f, x + slack * toward).squaredNorm(), 1) << "particle " << p << " ellipsoid " << e;
+                    for (const Vec3& d : directions)
+                        ASSERT_GE(to_unit_sphere(f, x + slack * d).squaredNorm(), 1) << "particle " << p << " ellipsoid " << e;
+                    ++checked;
+                }
+            }
+        },
+        default_skirt, fast_walk());
+    EXPECT_GT(checked, 100000u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, CollisionOnWalk, ::testing::Values(ClothModel::simplified, ClothModel::classic),
