@@ -173,9 +173,8 @@ struct Garment {
     std::vector<std::uint64_t> candidates;   ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
     std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep.
     bool lists_valid = false;                ///< False: rebuild the candidate lists before the next test.
-    Matrix3X list_anchor_x;                  ///< Particle positions (anchor frame) when each list was built.
-    std::vector<Real> list_epoch_move;       ///< Per particle: ellipsoid displacement since the epoch when its list was built.
-    std::vector<Affine3> list_anchor_frames; ///< Unit sphere -> anchor frame of each collider at the epoch (last full build).
+    Matrix3X list_anchor_x;                  ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
+    std::vector<Affine3> list_anchor_frames; ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed (zero: none).
     VectorX list_budget_m;                   ///< Per particle: how far it and the colliders may move before its list could miss one, m.
     VectorX list_slack_m;                    ///< Per particle: what is left of that budget after the last list update, m.
     Matrix3X list_scratch;                   ///< Anchor-frame positions, reused by the list bookkeeping every substep.
