@@ -112,7 +112,6 @@ std::uint64_t count_non_finite(const Garment& g) {
 void collide_garment_step(const Registry& registry, Garment& g, const FrameContext& context) {
     prepare_garment(g);
     update_frames(registry, g, Real(context.substep + 1) / Real(context.substeps));
-    if (g.model == ClothModel::simplified) g.x_constrained = g.x;  // no allocation once sized
     const CollisionResult r = collide_garment(g, nullptr, static_cast<Real>(context.h_s));
     g.counters.unresolved += r.unresolved;
 
@@ -123,44 +122,6 @@ void collide_garment_step(const Registry& registry, Garment& g, const FrameConte
         std::fprintf(stderr, "drape: cloth: %llu non-finite particle values after step %llu; garment reset to rest\n",
                      static_cast<unsigned long long>(bad), static_cast<unsigned long long>(g.counters.steps));
         reset_garment_state(registry, g);
-        return;
-    }
-    if (g.model == ClothModel::simplified) carry_layer2_contacts(g);
-}
-
-void carry_layer2_contacts(Garment& g) {
-    const GarmentTopology& t = *g.topology;
-    if (g.x_constrained.cols() != g.x.cols()) return;
-    const Eigen::Index layer1 = static_cast<Eigen::Index>(t.layer1_count);
-    Matrix3X& carried = g.force;  // scratch: the integration recomputes it
-    carried.leftCols(layer1).setZero();
-    bool any = false;
-    for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
-        const std::uint32_t i = t.weft_particle[k];
-        if (g.inv_mass[i] == 0) continue;
-        const Vec3 push = g.x.col(i) - g.x_constrained.col(i);
-        if (push.squaredNorm() == 0) continue;
-        any = true;
-        const Real s = t.weft_t[k];
-        const Vec3 left = (1 - s) * push, right = s * push;
-        if (left.squaredNorm() > carried.col(t.weft_left[k]).squaredNorm()) carried.col(t.weft_left[k]) = left;
-        if (right.squaredNorm() > carried.col(t.weft_right[k]).squaredNorm()) carried.col(t.weft_right[k]) = right;
-    }
-    if (!any) return;
-    for (Eigen::Index i = 0; i < layer1; ++i) {
-        if (g.inv_mass[i] == 0 || carried.col(i).squaredNorm() == 0) continue;
-        const Vec3 moved = g.x.col(i) + carried.col(i);
-        bool inside = false;
-        for (const EllipsoidFrame& f : g.frames) {
-            if (!f.active) continue;
-            const Real r_max = f.radii_m.maxCoeff();
-            if ((moved - f.center).squaredNorm() >= r_max * r_max) continue;
-            if (to_unit_sphere(f, moved).squaredNorm() < 1) {
-                inside = true;
-                break;
-            }
-        }
-        if (!inside) g.x.col(i) = moved;
     }
 }
 

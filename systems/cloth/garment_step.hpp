@@ -4,8 +4,7 @@
 // Order within a substep (method §1 item 4):
 //   integrate_garment   method §3.3-§3.4 (+ pins, §3.5)
 //   constrain_garment   method §4.1 warp, §4.2 weft
-//   collide_garment_step method §5, then the non-finite check, then (simplified)
-//                        carry_layer2_contacts
+//   collide_garment_step method §5, then the non-finite check
 #pragma once
 
 #include "components/garment.hpp"
@@ -28,15 +27,6 @@ void constrain_garment(Garment& garment, const FrameContext& context);
 /// Collision against the colliders at the end of the substep, then the non-finite check:
 /// a garment with a NaN or infinity is reported on stderr, counted, and reset.
 void collide_garment_step(const Registry& registry, Garment& garment, const FrameContext& context);
-
-/// Simplified model, the last step of collide_garment_step: a layer-2 particle has no mass,
-/// so what the collision did to it must reach the layer-1 lines that place it. Each of its
-/// two layer-1 neighbours is moved by its weight's share of the particle's push-out
-/// ((1 - t) and t; the largest share when several particles push one), unless that would
-/// put it inside an ellipsoid; velocities are kept. Next substep the edge, and with it the
-/// particle's chord, starts out of the body the particle was pushed from instead of being
-/// placed back through it. Uses `x_constrained` (the positions before the collision).
-void carry_layer2_contacts(Garment& garment);
 
 /// Back to rest around the body at its current place: the rest shape in the anchor's frame,
 /// pins on their bindings, velocities those of the body, collision state cleared, pushed
