@@ -184,7 +184,6 @@ struct Garment {
     // Scratch and caches the systems keep between substeps (no allocation per step).
     Matrix3X force;                          ///< Spring forces, N.
     Matrix3X x_start;                        ///< Positions at the start of the substep (contact velocities).
-    Matrix3X x_constrained;                  ///< Positions after the constraint system (simplified: the collision's move of layer 2).
     Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
     Matrix3X normals;                        ///< Layer-1 normals for weft placement.
     Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.
