@@ -24,31 +24,25 @@ inline Real surface_clearance(const EllipsoidFrame& f) {
 // Re-test rounds for a particle pushed between overlapping ellipsoids, before the fallback.
 constexpr int max_retest_rounds = 4;
 
-// Distance along the ray o + t d (|d| = 1) at which it leaves the ellipsoid; -inf if it misses.
-// In double: the quadratic loses digits when the ray is nearly tangent.
-inline Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
-    const Eigen::Vector3d oo = to_unit_sphere(f, o).cast<double>();
-    const Eigen::Vector3d dd = (f.to_unit * d).cast<double>();
-    const double a = dd.squaredNorm(), b = 2 * oo.dot(dd), c = oo.squaredNorm() - 1;
-    const double disc = b * b - 4 * a * c;
-    if (disc < 0 || a <= 0) return -std::numeric_limits<Real>::infinity();
-    return static_cast<Real>((-b + std::sqrt(disc)) / (2 * a));
-}
-
 // The response of one contact (method §5): onto the surface along the centre line, or
 // along the outward normal at the particle when that way out is shorter. Deep inside an
 // elongated ellipsoid (a thigh the hem swung into) the centre line runs along the long axis
 // and would carry the particle tens of centimetres toward the knee; the normal leaves by
 // the short side. Near the surface both agree.
 inline void respond_shortest(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
-    const Real y_length = y.norm();
-    if (y_length > Real(1e-6)) {
-        const Vec3 normal = (f.to_unit.transpose() * y).normalized();
-        const Real along_normal = ray_exit(f, x, normal);
-        const Real along_centre = (x - f.center).norm() * (1 / y_length - 1);
-        if (along_normal >= 0 && along_normal < along_centre) {
-            // push_out only rescales this point's unit-sphere image onto the surface (+ clearance).
-            push_out(f, to_unit_sphere(f, x + along_normal * normal), x, v);
+    const Real y_sq = y.squaredNorm();
+    if (y_sq > Real(1e-12)) {
+        // Along the normal n = L^T y (L = to_unit): the unit-sphere image moves along d = L n,
+        // |y + s d| = 1 at s = -2c / (b + sqrt(b^2 - 4ac)) with a = |d|^2, b = 2 y.d = 2 |n|^2,
+        // c = |y|^2 - 1 < 0 (the form without cancellation); the world move is s |n|.
+        const Vec3 n = f.to_unit.transpose() * y;
+        const Vec3 d = f.to_unit * n;
+        const Real a = d.squaredNorm(), b = 2 * n.squaredNorm(), c = y_sq - 1;
+        const Real s = -2 * c / (b + std::sqrt(b * b - 4 * a * c));
+        const Real along_normal = s * n.norm();
+        const Real along_centre = (x - f.center).norm() * (1 / std::sqrt(y_sq) - 1);
+        if (along_normal < along_centre) {
+            push_out(f, y + s * d, x, v);  // rescales that unit-sphere point onto the surface (+ clearance)
             return;
         }
     }
