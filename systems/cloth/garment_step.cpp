@@ -92,6 +92,11 @@ void constrain_garment(Garment& g, const FrameContext& ctx) {
         // (item 3) is part of the placement: each particle's one free coordinate is kept where
         // its warp spring and weft segments hold the limit (weft.hpp), so after this no
         // layer-2 warp spring below a free particle exceeds 1.10 x rest either.
+        if (lift_chords_below_pins(t, g.inv_mass, g.x, g.v, g.force, o.h_s, o.limit)) {
+            StrainLimitOptions ordered = o;
+            ordered.iterations = 0;
+            limit_strain(t.warp1, g.x, g.v, g.movable, ordered);
+        }
         compute_layer1_normals(t, g.x, g.normals);
         place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, o.h_s, o.limit);
     } else {

@@ -114,6 +114,40 @@ void place_weft(const GarmentTopology& t, const Matrix3X& normals, const VectorX
     }
 }
 
+bool lift_chords_below_pins(const GarmentTopology& t, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
+                            Matrix3X& scratch, Real h, Real limit) {
+    constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+    const Real reach = 1 + limit;
+    const Eigen::Index layer1 = static_cast<Eigen::Index>(t.layer1_count);
+    const Real inv_h = h > 0 ? 1 / h : 0;
+    bool any = false;
+    for (int round = 0; round < 3; ++round) {
+        bool moved = false;
+        scratch.leftCols(layer1).setZero();
+        for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+            const std::uint32_t above = t.weft_above[k];
+            if (above == none || inv_mass[above] != 0 || inv_mass[t.weft_particle[k]] == 0) continue;
+            const std::uint32_t a = t.weft_left[k], b = t.weft_right[k];
+            const Real s = t.weft_t[k];
+            const Vec3 to_pin = x.col(above) - ((1 - s) * x.col(a) + s * x.col(b));
+            const Real distance = to_pin.norm(), l = reach * t.weft_above_rest_m[k] * Real(0.999);
+            if (distance <= l) continue;
+            const Vec3 shift = to_pin * ((distance - l) / distance);
+            for (const std::uint32_t end : {a, b})
+                if (shift.squaredNorm() > scratch.col(end).squaredNorm()) scratch.col(end) = shift;
+            moved = true;
+        }
+        if (!moved) break;
+        any = true;
+        for (Eigen::Index i = 0; i < layer1; ++i) {
+            if (inv_mass[i] == 0) continue;
+            x.col(i) += scratch.col(i);
+            v.col(i) += scratch.col(i) * inv_h;
+        }
+    }
+    return any;
+}
+
 Real weft_plane_distance(const GarmentTopology& t, const Matrix3X& normals, const Matrix3X& x, std::size_t k) {
     const Vec3 p = plane_of(t, normals, x, k);
     return p.dot(x.col(t.weft_particle[k]) - x.col(t.weft_left[k]));

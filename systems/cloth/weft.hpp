@@ -41,6 +41,16 @@ namespace drape {
 /// Step 1: unit normals of the layer-1 particles (columns [0, layer1_count) of `normals`).
 void compute_layer1_normals(const GarmentTopology& topology, const Matrix3X& x, Matrix3X& normals);
 
+/// Before step 2, under the fitting zone: where a layer-2 particle hangs from a pinned one
+/// whose skin point lies farther than (1 + limit) x rest from the particle's chord point,
+/// both layer-1 ends of the chord move toward the pinned particle by the excess (the
+/// largest request per particle, 3 rounds; velocities follow when h_s > 0). The chord is
+/// then a place the particle may take, so the back-off of step 3 holds its spring too.
+/// `scratch`: 3 x layer1_count or more. True when anything moved: the layer-1 warp then
+/// needs its ordered Provot pass again.
+bool lift_chords_below_pins(const GarmentTopology& topology, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
+                            Matrix3X& scratch, Real h_s, Real strain_limit = Real(0.10));
+
 /// Steps 2-3: places the free layer-2 particles and writes each one's plane normal into
 /// `plane_normal` (zero for particles without a plane).
 void place_weft(const GarmentTopology& topology, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,

@@ -140,5 +140,41 @@ TEST(StrainLayer2, RowsAboveGoBackOntoTheirChordsWhereNoBulgeHoldsTheWarpSpring)
     }
 }
 
+// Under the fitting zone the pinned layer-2 particles sit off their chords (the waist curves
+// around the body): with layer 1 hanging at its limit, the chord below lies farther than the
+// limit from them. Lifting the chord's layer-1 ends toward the pinned particle brings every
+// hanging particle's chord point within the limit, so the back-off can hold that spring too.
+TEST(StrainLayer2, ChordsBelowThePinsAreLiftedWithinTheLimitOfThePinnedParticles) {
+    RectangleParams params;
+    params.warp_lines = 4;
+    params.particles_per_line = 4;
+    params.width_m = Real(0.3);
+    params.length_m = Real(0.3);
+    Garment g = *make_rectangle(params);
+    const GarmentTopology& t = *g.topology;
+    for (std::uint32_t line = 0; line < 4; ++line)
+        for (std::uint32_t row = 0; row < 4; ++row) {
+            const std::uint32_t i = t.grid[line * 4 + row];
+            g.x.col(i) = params.origin + Vec3(Real(0.1) * Real(line), Real(-0.1099) * Real(row), 0);
+            if (row == 0 && t.layer[i] == 2) g.x(2, i) += Real(0.05);  // pinned, off its chord
+        }
+    g.v.setZero();
+    prepare_garment(g);
+    const Matrix3X before = g.x;
+    EXPECT_TRUE(lift_chords_below_pins(t, g.inv_mass, g.x, g.v, g.force, Real(0.01), Real(0.10)));
+    for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+        if (k % 4 != 1) continue;  // row 1 hangs from the pinned row 0
+        const Vec3 chord = (1 - t.weft_t[k]) * g.x.col(t.weft_left[k]) + t.weft_t[k] * g.x.col(t.weft_right[k]);
+        EXPECT_LE((chord - g.x.col(t.weft_above[k])).norm(), Real(1.10) * t.weft_above_rest_m[k] * tolerance) << "entry " << k;
+    }
+    // Only the layer-1 particles of row 1 moved, and their velocities followed (h = 0.01 s).
+    for (Eigen::Index i = 0; i < g.x.cols(); ++i) {
+        const Vec3 move = g.x.col(i) - before.col(i);
+        const bool row1_layer1 = t.layer[static_cast<std::size_t>(i)] == 1 && (t.grid[1] == i || t.grid[3 * 4 + 1] == i);
+        if (!row1_layer1) EXPECT_EQ(move.norm(), 0) << "particle " << i;
+        else EXPECT_LT((g.v.col(i) - move / Real(0.01)).norm(), 1e-3) << "particle " << i;
+    }
+}
+
 }  // namespace
 }  // namespace drape
