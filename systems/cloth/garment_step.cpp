@@ -92,6 +92,8 @@ void constrain_garment(Garment& g, const FrameContext& ctx) {
         // (item 3) is part of the placement: each particle's one free coordinate is kept where
         // its warp spring and weft segments hold the limit (weft.hpp), so after this no
         // layer-2 warp spring below a free particle exceeds 1.10 x rest either.
+        // Under the fitting zone, chords out of reach of the pinned particle above them are
+        // lifted first (weft.hpp); the layer-1 warp then gets its ordered pass again.
         if (lift_chords_below_pins(t, g.inv_mass, g.x, g.v, g.force, o.h_s, o.limit)) {
             StrainLimitOptions ordered = o;
             ordered.iterations = 0;
