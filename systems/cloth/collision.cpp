@@ -24,29 +24,56 @@ inline Real surface_clearance(const EllipsoidFrame& f) {
 // Re-test rounds for a particle pushed between overlapping ellipsoids, before the fallback.
 constexpr int max_retest_rounds = 4;
 
+// Where a particle at unit-sphere image y leaves the ellipsoid along its centre line
+// (method §5): on the surface plus a clearance. At the centre there is no centre line; it
+// leaves along the longest axis. Returns the unit-sphere image of the new place.
+inline Vec3 place_on_surface(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x) {
+    Vec3 y = y_in;
+    Real length = y.norm();
+    if (length <= Real(1e-6)) {
+        Eigen::Index axis = 0;
+        f.radii_m.maxCoeff(&axis);
+        y = Vec3::Unit(axis);
+        length = 1;
+    }
+    const Vec3 y_surface = y * ((1 + surface_clearance(f)) / length);
+    x = f.center + f.rotation * f.radii_m.cwiseProduct(y_surface);
+    return y_surface;
+}
+
+// A centre-line push-out shorter than this share of the smallest radius is taken as it is:
+// near the surface the centre line and the normal agree to within a fraction of it.
+constexpr Real shallow_share = Real(0.25);
+
 // The response of one contact (method §5): onto the surface along the centre line, or
 // along the outward normal at the particle when that way out is shorter. Deep inside an
 // elongated ellipsoid (a thigh the hem swung into) the centre line runs along the long axis
 // and would carry the particle tens of centimetres toward the knee; the normal leaves by
-// the short side. Near the surface both agree.
-inline void respond_shortest(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
+// the short side. Returns the unit-sphere image of the new place.
+inline Vec3 place_shortest(const EllipsoidFrame& f, const Vec3& y, Vec3& x) {
     const Real y_sq = y.squaredNorm();
     if (y_sq > Real(1e-12)) {
-        // Along the normal n = L^T y (L = to_unit): the unit-sphere image moves along d = L n,
-        // |y + s d| = 1 at s = -2c / (b + sqrt(b^2 - 4ac)) with a = |d|^2, b = 2 y.d = 2 |n|^2,
-        // c = |y|^2 - 1 < 0 (the form without cancellation); the world move is s |n|.
-        const Vec3 n = f.to_unit.transpose() * y;
-        const Vec3 d = f.to_unit * n;
-        const Real a = d.squaredNorm(), b = 2 * n.squaredNorm(), c = y_sq - 1;
-        const Real s = -2 * c / (b + std::sqrt(b * b - 4 * a * c));
-        const Real along_normal = s * n.norm();
         const Real along_centre = (x - f.center).norm() * (1 / std::sqrt(y_sq) - 1);
-        if (along_normal < along_centre) {
-            push_out(f, y + s * d, x, v);  // rescales that unit-sphere point onto the surface (+ clearance)
-            return;
+        if (along_centre > shallow_share * f.radii_m.minCoeff()) {
+            // Along the normal n = L^T y (L = to_unit): the unit-sphere image moves along d = L n,
+            // |y + s d| = 1 at s = -2c / (b + sqrt(b^2 - 4ac)) with a = |d|^2, b = 2 y.d = 2 |n|^2,
+            // c = |y|^2 - 1 < 0 (the form without cancellation); the world move is s |n|.
+            const Vec3 n = f.to_unit.transpose() * y;
+            const Vec3 d = f.to_unit * n;
+            const Real a = d.squaredNorm(), b = 2 * n.squaredNorm(), c = y_sq - 1;
+            const Real s = -2 * c / (b + std::sqrt(b * b - 4 * a * c));
+            if (s * n.norm() < along_centre) return place_on_surface(f, y + s * d, x);
         }
     }
-    push_out(f, y, x, v);
+    return place_on_surface(f, y, x);
+}
+
+// Inelastic contact (method §5): no velocity into the surface, relative to its motion.
+inline void remove_approach(const EllipsoidFrame& f, const Vec3& y_surface, const Vec3& x, Vec3& v) {
+    const Vec3 normal = (f.to_unit.transpose() * y_surface).normalized();
+    const Vec3 surface_velocity = body_velocity_at(f, x);
+    const Real approach = (v - surface_velocity).dot(normal);
+    if (approach < 0) v -= approach * normal;
 }
 
 template <class F>
@@ -300,21 +327,8 @@ Real penetration_depth(const EllipsoidFrame& f, const Vec3& x) {
     return (x - f.center).norm() * (1 / y - 1);
 }
 
-void push_out(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x, Vec3& v) {
-    Vec3 y = y_in;
-    Real length = y.norm();
-    if (length <= Real(1e-6)) {  // at the centre: no centre line; leave along the longest axis
-        Eigen::Index axis = 0;
-        f.radii_m.maxCoeff(&axis);
-        y = Vec3::Unit(axis);
-        length = 1;
-    }
-    const Vec3 y_surface = y * ((1 + surface_clearance(f)) / length);
-    x = f.center + f.rotation * f.radii_m.cwiseProduct(y_surface);
-    const Vec3 normal = (f.to_unit.transpose() * y_surface).normalized();
-    const Vec3 surface_velocity = body_velocity_at(f, x);
-    const Real approach = (v - surface_velocity).dot(normal);
-    if (approach < 0) v -= approach * normal;
+void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
+    remove_approach(f, place_on_surface(f, y, x), x, v);
 }
 
 std::uint64_t active_mask(std::span<const EllipsoidFrame> frames) {
@@ -352,6 +366,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
     last_collided.resize(static_cast<std::size_t>(n), 0);
     if (detected) detected->assign(static_cast<std::size_t>(n), 0);
     const std::uint64_t active = active_mask(frames);
+    const bool whole_move = x_start != nullptr && h > 0;
 
     for (Eigen::Index p = 0; p < n; ++p) {
         const std::size_t pi = static_cast<std::size_t>(p);
@@ -386,7 +401,8 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
             const Vec3 y = to_unit_sphere(f, xp);
             if (y.squaredNorm() >= 1) return false;
-            respond_shortest(f, y, xp, vp);
+            const Vec3 y_surface = place_shortest(f, y, xp);
+            if (!whole_move) remove_approach(f, y_surface, xp, vp);  // else from the whole move, below
             ++r.collisions;
             return true;
         };
@@ -420,7 +436,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                 if (depth > Real(1e-5)) ++r.unresolved;
             }
         }
-        if (x_start != nullptr && h > 0) {
+        if (whole_move) {
             // Velocity of the whole move, then no normal velocity relative to any surface touched.
             vp = (xp - x_start->col(p)) / h;
             for_each_bit(last_collided[pi], [&](int e) {
