@@ -117,35 +117,62 @@ void place_weft(const GarmentTopology& t, const Matrix3X& normals, const VectorX
 bool lift_chords_below_pins(const GarmentTopology& t, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
                             Matrix3X& scratch, Real h, Real limit) {
     constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+    constexpr int max_rounds = 32;
+    // Targets a little inside the limits so that the rounds end with both sets of springs
+    // strictly within them, float rounding included.
+    constexpr Real aim = Real(0.995);
     const Real reach = 1 + limit;
     const Eigen::Index layer1 = static_cast<Eigen::Index>(t.layer1_count);
-    const Real inv_h = h > 0 ? 1 / h : 0;
-    bool any = false;
-    for (int round = 0; round < 3; ++round) {
-        bool moved = false;
-        scratch.leftCols(layer1).setZero();
+    const auto free_particle = [&](std::uint32_t i) { return inv_mass[i] != 0; };
+    // The chords out of reach of the pinned particle above them.
+    const auto out_of_reach = [&](Real scale) {
         for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
             const std::uint32_t above = t.weft_above[k];
-            if (above == none || inv_mass[above] != 0 || inv_mass[t.weft_particle[k]] == 0) continue;
+            if (above == none || free_particle(above) || !free_particle(t.weft_particle[k])) continue;
+            const Real s = t.weft_t[k];
+            const Vec3 c = (1 - s) * x.col(t.weft_left[k]) + s * x.col(t.weft_right[k]);
+            const Real l = scale * reach * t.weft_above_rest_m[k];
+            if ((x.col(above) - c).squaredNorm() > l * l) return true;
+        }
+        return false;
+    };
+    if (!out_of_reach(1)) return false;
+
+    // Alternating projections (Gauss-Seidel) onto two sets of constraints on layer 1:
+    //   chord:  |(1 - s) x_a + s x_b - x_pinned| <= aim (1 + limit) rest   (layer-2 warp spring)
+    //   warp:   |x_b - x_pinned| <= aim (1 + limit) rest                    (layer-1 warp spring)
+    // A chord's correction is the shortest move of its free ends that brings its point onto
+    // the sphere (ends weighted by their share of the point); a layer-1 spring's moves its
+    // free end. Both sets are convex, so the rounds converge wherever they meet.
+    scratch.leftCols(layer1) = x.leftCols(layer1);
+    const SpringPhase& warp = t.warp1;
+    for (int round = 0; round < max_rounds && out_of_reach(1); ++round) {
+        for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+            const std::uint32_t above = t.weft_above[k];
+            if (above == none || free_particle(above) || !free_particle(t.weft_particle[k])) continue;
             const std::uint32_t a = t.weft_left[k], b = t.weft_right[k];
             const Real s = t.weft_t[k];
+            const Real wa = free_particle(a) ? 1 - s : 0, wb = free_particle(b) ? s : 0;
+            const Real share = wa * (1 - s) + wb * s;
+            if (share <= 0) continue;  // both ends pinned: the skin decides
             const Vec3 to_pin = x.col(above) - ((1 - s) * x.col(a) + s * x.col(b));
-            const Real distance = to_pin.norm(), l = reach * t.weft_above_rest_m[k] * Real(0.999);
+            const Real distance = to_pin.norm(), l = aim * reach * t.weft_above_rest_m[k];
             if (distance <= l) continue;
-            const Vec3 shift = to_pin * ((distance - l) / distance);
-            for (const std::uint32_t end : {a, b})
-                if (shift.squaredNorm() > scratch.col(end).squaredNorm()) scratch.col(end) = shift;
-            moved = true;
+            const Vec3 step = to_pin * ((distance - l) / (distance * share));
+            x.col(a) += wa * step;
+            x.col(b) += wb * step;
         }
-        if (!moved) break;
-        any = true;
-        for (Eigen::Index i = 0; i < layer1; ++i) {
-            if (inv_mass[i] == 0) continue;
-            x.col(i) += scratch.col(i);
-            v.col(i) += scratch.col(i) * inv_h;
+        for (std::size_t s = 0; s < warp.size(); ++s) {
+            const bool fa = free_particle(warp.a[s]), fb = free_particle(warp.b[s]);
+            if (fa == fb) continue;  // only springs from a pinned particle to a free one
+            const std::uint32_t pinned = fa ? warp.b[s] : warp.a[s], moving = fa ? warp.a[s] : warp.b[s];
+            const Vec3 d = x.col(moving) - x.col(pinned);
+            const Real length = d.norm(), l = aim * reach * warp.rest_m[s];
+            if (length > l) x.col(moving) = x.col(pinned) + d * (l / length);
         }
     }
-    return any;
+    if (h > 0) v.leftCols(layer1) += (x.leftCols(layer1) - scratch.leftCols(layer1)) / h;
+    return true;
 }
 
 Real weft_plane_distance(const GarmentTopology& t, const Matrix3X& normals, const Matrix3X& x, std::size_t k) {

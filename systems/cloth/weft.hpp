@@ -24,8 +24,9 @@
 //        springs beside it, so its length is at most the same blend of theirs: within
 //        (1 + limit) x rest when theirs are (Provot's ordered pass, §4.1) and its rest is
 //        that blend of their rests (grid builders: equal). 0 is then in I and in W.
-//   Guarantees after the placement: every layer-2 warp spring whose upper end is free is
-//   at most (1 + limit) x rest; every weft segment beside a free layer-2 particle that does
+//   Guarantees after the placement: every layer-2 warp spring with a free end is at most
+//   (1 + limit) x rest (below the pins once the chords are within reach, see
+//   lift_chords_below_pins); every weft segment beside a free layer-2 particle that does
 //   not hang from a pinned one is at most max(l, |e| / stride). A particle hanging from a
 //   pinned one gets its warp spring first (I alone if it misses W, else the nearest bulge):
 //   the fitting zone's skin points curve around the body, off the planes below them.
@@ -41,13 +42,15 @@ namespace drape {
 /// Step 1: unit normals of the layer-1 particles (columns [0, layer1_count) of `normals`).
 void compute_layer1_normals(const GarmentTopology& topology, const Matrix3X& x, Matrix3X& normals);
 
-/// Before step 2, under the fitting zone: where a layer-2 particle hangs from a pinned one
-/// whose skin point lies farther than (1 + limit) x rest from the particle's chord point,
-/// both layer-1 ends of the chord move toward the pinned particle by the excess (the
-/// largest request per particle, 3 rounds; velocities follow when h_s > 0). The chord is
-/// then a place the particle may take, so the back-off of step 3 holds its spring too.
-/// `scratch`: 3 x layer1_count or more. True when anything moved: the layer-1 warp then
-/// needs its ordered Provot pass again.
+/// Before step 2, under the fitting zone (method §3.5): where a layer-2 particle hangs from a
+/// pinned one whose skin point lies farther than (1 + limit) x rest from the particle's chord
+/// point, the chord's free layer-1 ends move toward the pinned particle, while every layer-1
+/// warp spring from a pinned particle to a free one stays within (1 + limit) x rest:
+/// alternating projections onto both sets of constraints, aimed 0.5 % inside the limits, until
+/// every chord point is within reach (at most 32 rounds; velocities follow when h_s > 0). The
+/// chord is then a place the particle may take, so the back-off of step 3 holds its warp
+/// spring too. `scratch`: 3 x layer1_count or more. True when anything moved: the layer-1 warp
+/// then needs its ordered Provot pass again (it leaves the springs from the pins as they are).
 bool lift_chords_below_pins(const GarmentTopology& topology, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
                             Matrix3X& scratch, Real h_s, Real strain_limit = Real(0.10));
 
