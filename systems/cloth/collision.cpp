@@ -85,6 +85,41 @@ inline void for_each_bit(std::uint64_t bits, F&& f) {
     }
 }
 
+// ---- Detection (method §5): the unit-sphere test, 8 consecutive particles at a time.
+
+constexpr Eigen::Index detect_lanes = 8;
+using DetectLanes = Eigen::Array<Real, detect_lanes, 1>;
+using LaneBits = std::array<std::uint64_t, detect_lanes>;
+
+// Bit e of hits[l] is set when ellipsoid e is in tested[l] and contains particle begin + l
+// (|y| < 1). Every ellipsoid in any of the lists is tested against the whole block in one
+// pass of vector instructions; lanes whose list leaves it out are discarded. Brute force's
+// reference detection uses the same arithmetic, so both agree to the bit.
+inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index count,
+                         std::span<const EllipsoidFrame> frames, const LaneBits& tested, LaneBits& hits) {
+    DetectLanes p0 = DetectLanes::Zero(), p1 = DetectLanes::Zero(), p2 = DetectLanes::Zero();
+    std::uint64_t any = 0;
+    for (Eigen::Index l = 0; l < count; ++l) {
+        p0[l] = x(0, begin + l);
+        p1[l] = x(1, begin + l);
+        p2[l] = x(2, begin + l);
+        any |= tested[static_cast<std::size_t>(l)];
+    }
+    hits.fill(0);
+    for_each_bit(any, [&](int e) {
+        const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+        const Mat3& m = f.to_unit;
+        const DetectLanes d0 = p0 - f.center[0], d1 = p1 - f.center[1], d2 = p2 - f.center[2];
+        const DetectLanes y0 = m(0, 0) * d0 + m(0, 1) * d1 + m(0, 2) * d2;
+        const DetectLanes y1 = m(1, 0) * d0 + m(1, 1) * d1 + m(1, 2) * d2;
+        const DetectLanes y2 = m(2, 0) * d0 + m(2, 1) * d1 + m(2, 2) * d2;
+        const DetectLanes y_sq = y0 * y0 + y1 * y1 + y2 * y2;
+        const std::uint64_t bit = std::uint64_t(1) << e;
+        for (std::size_t l = 0; l < static_cast<std::size_t>(detect_lanes); ++l)
+            hits[l] |= y_sq[static_cast<Eigen::Index>(l)] < 1 ? tested[l] & bit : 0;
+    });
+}
+
 // ---- Candidate lists (method §5, spatial locality); see collision.hpp step 1.
 
 // An ellipsoid's bit is refreshed in every list once the ellipsoid has moved this share of
@@ -155,12 +190,11 @@ public:
             const Lanes y2 = c.to_unit[6] * x[0] + c.to_unit[7] * x[1] + c.to_unit[8] * x[2] - c.offset[2];
             const Lanes sphere = c.r_min * ((y0 * y0 + y1 * y1 + y2 * y2).sqrt() - 1);  // as clearance_of
             const Lanes box0 = c.radii[0] * (y0.abs() - 1), box1 = c.radii[1] * (y1.abs() - 1), box2 = c.radii[2] * (y2.abs() - 1);
-            for (std::size_t l = 0; l < width; ++l) {
-                const int i = static_cast<int>(l);
-                const Real clearance = std::max(std::max(sphere[i], box0[i]), std::max(box1[i], box2[i]));
-                bits |= clearance <= margin ? c.bit[l] : 0;
-                nearest = std::min(nearest, clearance <= margin ? std::numeric_limits<Real>::infinity() : clearance);
-            }
+            const Lanes clearance = sphere.max(box0).max(box1.max(box2));
+            const auto listed = clearance <= margin;
+            nearest = std::min(nearest, listed.select(Lanes::Constant(std::numeric_limits<Real>::infinity()), clearance).minCoeff());
+            if (listed.any())
+                for (std::size_t l = 0; l < width; ++l) bits |= listed[static_cast<Eigen::Index>(l)] ? c.bit[l] : 0;
         }
         return nearest;
     }
@@ -368,8 +402,17 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
     const std::uint64_t active = active_mask(frames);
     const bool whole_move = x_start != nullptr && h > 0;
 
+    LaneBits block_lists{}, block_hits{};
     for (Eigen::Index p = 0; p < n; ++p) {
         const std::size_t pi = static_cast<std::size_t>(p);
+        if (candidates && p % detect_lanes == 0) {
+            // List mode: the lists of the next block of particles at once (detect_block).
+            const Eigen::Index count = std::min(detect_lanes, n - p);
+            block_lists.fill(0);
+            for (Eigen::Index l = 0; l < count; ++l)
+                if (inv_mass[p + l] != 0) block_lists[static_cast<std::size_t>(l)] = (*candidates)[pi + static_cast<std::size_t>(l)] & active;
+            detect_block(x, p, count, frames, block_lists, block_hits);
+        }
         if (inv_mass[p] == 0) {
             last_collided[pi] = 0;
             continue;
@@ -378,19 +421,21 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         const std::uint64_t last = last_collided[pi] & list;
         Vec3 xp = x.col(p);
         std::uint64_t hits = 0;
-        auto detect = [&](int e) {
-            ++r.tests;
+        if (candidates) {
+            r.tests += static_cast<std::uint64_t>(std::popcount(list));
+            hits = block_hits[static_cast<std::size_t>(p % detect_lanes)];
+        } else {
+            for_each_bit(list, [&](int e) {
+                ++r.tests;
+                if (to_unit_sphere(frames[static_cast<std::size_t>(e)], xp).squaredNorm() < 1) hits |= std::uint64_t(1) << e;
+            });
+        }
+        for_each_bit(hits, [&](int e) {
             const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
-            const Vec3 y = to_unit_sphere(f, xp);
-            const Real y_sq = y.squaredNorm();
-            if (y_sq >= 1) return;
-            hits |= std::uint64_t(1) << e;
-            const Real y_len = std::sqrt(y_sq);
+            const Real y_len = to_unit_sphere(f, xp).norm();
             const Real depth = y_len > Real(1e-6) ? (xp - f.center).norm() * (1 / y_len - 1) : f.radii_m.minCoeff();
             r.max_penetration_m = std::max(r.max_penetration_m, depth);
-        };
-        for_each_bit(last, detect);          // temporal coherence: last substep's contacts first
-        for_each_bit(list & ~last, detect);  // then the rest of the pre-collision list
+        });
         if (detected) (*detected)[pi] = hits;
         last_collided[pi] = hits;
         if (hits == 0) continue;
@@ -453,12 +498,17 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
 }
 
 DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass, std::span<const EllipsoidFrame> frames) {
-    DetectedPairs out(static_cast<std::size_t>(x.cols()), 0);
-    for (Eigen::Index p = 0; p < x.cols(); ++p) {
-        if (inv_mass[p] == 0) continue;
-        for (std::size_t e = 0; e < frames.size() && e < 64; ++e)
-            if (frames[e].active && to_unit_sphere(frames[e], x.col(p)).squaredNorm() < 1)
-                out[static_cast<std::size_t>(p)] |= std::uint64_t(1) << e;
+    const Eigen::Index n = x.cols();
+    DetectedPairs out(static_cast<std::size_t>(n), 0);
+    const std::uint64_t active = active_mask(frames);
+    LaneBits tested{}, hits{};
+    for (Eigen::Index begin = 0; begin < n; begin += detect_lanes) {
+        const Eigen::Index count = std::min(detect_lanes, n - begin);
+        tested.fill(0);
+        for (Eigen::Index l = 0; l < count; ++l)
+            if (inv_mass[begin + l] != 0) tested[static_cast<std::size_t>(l)] = active;
+        detect_block(x, begin, count, frames, tested, hits);
+        for (Eigen::Index l = 0; l < count; ++l) out[static_cast<std::size_t>(begin + l)] = hits[static_cast<std::size_t>(l)];
     }
     return out;
 }
