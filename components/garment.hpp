@@ -175,8 +175,8 @@ struct Garment {
     bool lists_valid = false;                ///< False: rebuild the candidate lists before the next test.
     Matrix3X list_anchor_x;                  ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
     std::vector<Affine3> list_anchor_frames; ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed (zero: none).
-    VectorX list_budget_m;                   ///< Per particle: how far it and the colliders may move before its list could miss one, m.
-    VectorX list_slack_m;                    ///< Per particle: what is left of that budget after the last list update, m.
+    Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> list_clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
+    VectorX list_slack_m;                    ///< Per particle: how far it may still move before its list could miss a collider, after the last list update, m.
     Matrix3X list_scratch;                   ///< Anchor-frame positions, reused by the list bookkeeping every substep.
 
     GarmentCounters counters;
