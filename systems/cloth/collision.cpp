@@ -124,7 +124,7 @@ inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index cou
 
 // An ellipsoid's bit is refreshed in every list once the ellipsoid has moved this share of
 // the margin since its reference pose; a particle's list is refreshed when its own move
-// plus the largest ellipsoid move exceeds its budget. docs/cloth.md has the measurements.
+// plus that of an unlisted ellipsoid reaches the clearance between their references. docs/cloth.md has the measurements.
 constexpr Real ellipsoid_refresh_share = Real(0.5);
 // Particles per block in a bit refresh; a block whose bounding box is farther than the
 // margin from the ellipsoid's box is cleared without a test.
@@ -178,11 +178,10 @@ public:
     }
     [[nodiscard]] bool empty() const noexcept { return m_count == 0; }
 
-    // Sets `bits` to the ellipsoids within `margin` of x; returns the smallest clearance
-    // (clearance_of) of the others.
-    Real test(const Vec3& x, Real margin, std::uint64_t& bits) const {
+    // Sets `bits` to the ellipsoids within `margin` of x and `out[e]` to the clearance
+    // (clearance_of) of each other ellipsoid e, +inf for the listed ones.
+    void test(const Vec3& x, Real margin, std::uint64_t& bits, std::array<Real, 64>& out) const {
         bits = 0;
-        Real nearest = std::numeric_limits<Real>::infinity();
         for (int k = 0; k * width < m_count; ++k) {
             const Chunk& c = m_chunks[static_cast<std::size_t>(k)];
             const Lanes y0 = c.to_unit[0] * x[0] + c.to_unit[1] * x[1] + c.to_unit[2] * x[2] - c.offset[0];
@@ -192,11 +191,13 @@ public:
             const Lanes box0 = c.radii[0] * (y0.abs() - 1), box1 = c.radii[1] * (y1.abs() - 1), box2 = c.radii[2] * (y2.abs() - 1);
             const Lanes clearance = sphere.max(box0).max(box1.max(box2));
             const auto listed = clearance <= margin;
-            nearest = std::min(nearest, listed.select(Lanes::Constant(std::numeric_limits<Real>::infinity()), clearance).minCoeff());
-            if (listed.any())
-                for (std::size_t l = 0; l < width; ++l) bits |= listed[static_cast<Eigen::Index>(l)] ? c.bit[l] : 0;
+            const Lanes unlisted = listed.select(Lanes::Constant(std::numeric_limits<Real>::infinity()), clearance);
+            for (int l = 0; l < width && k * width + l < m_count; ++l) {
+                const std::uint64_t bit = c.bit[static_cast<std::size_t>(l)];
+                out[static_cast<std::size_t>(std::countr_zero(bit))] = unlisted[l];
+                bits |= listed[l] ? bit : 0;
+            }
         }
-        return nearest;
     }
 
 private:
@@ -235,19 +236,21 @@ struct PointBounds {
 };
 
 // Refreshes bit e of the lists of points x (any frame; `f` and `bounds` in the same frame):
-// set where a point is within `margin` of the ellipsoid, cleared elsewhere. With `budget`,
-// lowers each unlisted point's budget to its clearance.
+// set where a point is within `margin` of the ellipsoid, cleared elsewhere. With `clearance`
+// (one per point), stores each unlisted point's clearance from the ellipsoid, +inf for the
+// listed ones.
 std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const ListEllipsoid& f, std::size_t e,
-                          Real margin, std::vector<std::uint64_t>& candidates, VectorX* budget) {
+                          Real margin, std::vector<std::uint64_t>& candidates, Real* clearance_out) {
     const Eigen::Index n = x.cols();
     const std::uint64_t bit = std::uint64_t(1) << e;
     std::uint64_t* out = candidates.data();
-    Real* b = budget ? budget->data() : nullptr;
+    Real* b = clearance_out;
+    constexpr Real listed = std::numeric_limits<Real>::infinity();
     // Broad phase, whole garment then blocks: a gap between the boxes bounds every distance.
     if (const Real gap = bounds.gap(f); gap > margin) {
         for (Eigen::Index i = 0; i < n; ++i) out[i] &= ~bit;
         if (b)
-            for (Eigen::Index i = 0; i < n; ++i) b[i] = std::min(b[i], gap - clearance_rounding_m);
+            for (Eigen::Index i = 0; i < n; ++i) b[i] = gap - clearance_rounding_m;
         return 0;
     }
     std::uint64_t tests = 0;
@@ -259,7 +262,7 @@ std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const Li
         if (const Real gap = PointBounds(block).gap(f); gap > margin) {
             for (Eigen::Index i = begin; i < begin + count; ++i) out[i] &= ~bit;
             if (b)
-                for (Eigen::Index i = begin; i < begin + count; ++i) b[i] = std::min(b[i], gap - clearance_rounding_m);
+                for (Eigen::Index i = begin; i < begin + count; ++i) b[i] = gap - clearance_rounding_m;
             continue;
         }
         y.noalias() = f.to_unit * block;
@@ -268,7 +271,7 @@ std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const Li
         for (Eigen::Index i = 0; i < count; ++i) out[begin + i] = clearance[i] <= margin ? out[begin + i] | bit : out[begin + i] & ~bit;
         if (b)
             for (Eigen::Index i = 0; i < count; ++i)
-                b[begin + i] = clearance[i] <= margin ? b[begin + i] : std::min(b[begin + i], clearance[i] - clearance_rounding_m);
+                b[begin + i] = clearance[i] <= margin ? listed : clearance[i] - clearance_rounding_m;
         tests += static_cast<std::uint64_t>(count);
     }
     return tests;
@@ -551,7 +554,7 @@ void update_candidate_lists(Garment& g) {
     const Affine3 anchor = anchor_frame(g);
     const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
     const Real margin = g.material.candidate_margin_m;
-    VectorX& budget = g.list_budget_m;
+    auto& clearance = g.list_clearance_m;  // particle x ellipsoid, column e contiguous
     VectorX& slack = g.list_slack_m;
     std::uint64_t tests = 0;
 
@@ -561,27 +564,29 @@ void update_candidate_lists(Garment& g) {
     local.noalias() = to_anchor * g.x;
     local.colwise() -= to_anchor * anchor.translation();
     const bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
-                       budget.size() == n && g.candidates.size() == static_cast<std::size_t>(n);
+                       clearance.rows() == n && clearance.cols() == static_cast<Eigen::Index>(e_count) &&
+                       g.candidates.size() == static_cast<std::size_t>(n);
     if (!valid) {  // everything from scratch: every particle and every ellipsoid is its own reference
         g.candidates.assign(static_cast<std::size_t>(n), 0);
         g.list_anchor_x = local;
         g.list_anchor_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
-        budget.setConstant(n, std::numeric_limits<Real>::infinity());
+        clearance.setConstant(n, static_cast<Eigen::Index>(e_count), std::numeric_limits<Real>::infinity());
         ++g.counters.list_rebuilds;
     }
     slack.resize(n);
     slack = (local - g.list_anchor_x).colwise().norm().transpose();
 
     // 2. Ellipsoids: refresh bit e against the particles' reference points when e has moved
-    //    its share since its reference pose, which it then becomes. D = largest move left.
+    //    its share since its reference pose, which it then becomes. D_e: its move since.
     std::optional<PointBounds> bounds;  // of the reference points, on first use
     const Real ellipsoid_limit = ellipsoid_refresh_share * margin;
-    Real frame_move = 0;
+    std::array<Real, 64> moved_since{};
     for (std::size_t e = 0; e < e_count; ++e) {
         Affine3& then = g.list_anchor_frames[e];
         if (!g.frames[e].active) {
             if (has_reference(then)) {
                 tests += refresh_candidate_bit(g.list_anchor_x, g.frames, e, margin, g.candidates);  // clears it
+                clearance.col(static_cast<Eigen::Index>(e)).setConstant(std::numeric_limits<Real>::infinity());
                 then.matrix().setZero();
             }
             continue;
@@ -590,20 +595,30 @@ void update_candidate_lists(Garment& g) {
         const Affine3 now = unit_map(current);
         const Real moved = has_reference(then) ? ellipsoid_move(now, then) : std::numeric_limits<Real>::infinity();
         if (moved <= ellipsoid_limit) {
-            frame_move = std::max(frame_move, moved);
+            moved_since[e] = moved;
             continue;
         }
         if (!bounds) bounds.emplace(g.list_anchor_x);
-        tests += refresh_bit(g.list_anchor_x, *bounds, ListEllipsoid(current), e, margin, g.candidates, &budget);
+        tests += refresh_bit(g.list_anchor_x, *bounds, ListEllipsoid(current), e, margin, g.candidates,
+                             clearance.col(static_cast<Eigen::Index>(e)).data());
         then = now;
     }
 
-    // 3. Particles: a list is exact while d_p + D <= budget_p, the clearance of the
-    //    reference point from the nearest unlisted reference ellipsoid. A particle past it
-    //    becomes its own reference and is tested against every reference ellipsoid.
+    // 3. Particles: a list is exact while d_p + D_e < C_pe for every unlisted e, the
+    //    clearance between their references: the slack is min_e (C_pe - D_e) - d_p, whole
+    //    columns. A particle without slack becomes its own reference and is tested against
+    //    every reference ellipsoid.
     const std::uint64_t active = active_mask(g.frames);
-    slack.array() = budget.array() - slack.array() - frame_move;
+    VectorX room = VectorX::Constant(n, std::numeric_limits<Real>::infinity());
+    for_each_bit(active, [&](int e) {
+        const Real* c = clearance.col(e).data();
+        const Real moved = moved_since[static_cast<std::size_t>(e)];
+        Real* r = room.data();
+        for (Eigen::Index p = 0; p < n; ++p) r[p] = std::min(r[p], c[p] - moved);
+    });
+    slack = room - slack;
     EllipsoidLanes references;  // filled on first use
+    std::array<Real, 64> particle_clearance{};
     for (Eigen::Index p = 0; p < n; ++p) {
         if (slack[p] >= 0 || g.inv_mass[p] == 0) continue;  // pinned: never tested (method §3.5)
         if (references.empty()) {
@@ -613,9 +628,15 @@ void update_candidate_lists(Garment& g) {
         }
         g.list_anchor_x.col(p) = local.col(p);
         std::uint64_t bits = 0;
-        budget[p] = references.test(local.col(p), margin, bits) - clearance_rounding_m;
+        references.test(local.col(p), margin, bits, particle_clearance);
         g.candidates[static_cast<std::size_t>(p)] = bits;
-        slack[p] = std::max(Real(0), budget[p] - frame_move);
+        Real left = std::numeric_limits<Real>::infinity();
+        for_each_bit(active, [&](int e) {
+            const std::size_t ei = static_cast<std::size_t>(e);
+            clearance(p, e) = particle_clearance[ei] - clearance_rounding_m;
+            left = std::min(left, clearance(p, e) - moved_since[ei]);
+        });
+        slack[p] = std::max(Real(0), left);
         tests += static_cast<std::uint64_t>(std::popcount(active));
     }
     g.lists_valid = true;
