@@ -140,7 +140,8 @@ bool lift_chords_below_pins(const GarmentTopology& t, const VectorX& inv_mass, M
 
     // Alternating projections (Gauss-Seidel) onto two sets of constraints on layer 1:
     //   chord:  |(1 - s) x_a + s x_b - x_pinned| <= aim (1 + limit) rest   (layer-2 warp spring)
-    //   warp:   |x_b - x_pinned| <= aim (1 + limit) rest                    (layer-1 warp spring)
+    //   warp:   |x_b - x_pinned| <= aim (1 + limit) rest                    (layer-1 warp spring,
+    //                                                                         lifted ends only)
     // A chord's correction is the shortest move of its free ends that brings its point onto
     // the sphere (ends weighted by their share of the point); a layer-1 spring's moves its
     // free end. Both sets are convex, so the rounds converge wherever they meet.
@@ -166,6 +167,7 @@ bool lift_chords_below_pins(const GarmentTopology& t, const VectorX& inv_mass, M
             const bool fa = free_particle(warp.a[s]), fb = free_particle(warp.b[s]);
             if (fa == fb) continue;  // only springs from a pinned particle to a free one
             const std::uint32_t pinned = fa ? warp.b[s] : warp.a[s], moving = fa ? warp.a[s] : warp.b[s];
+            if (x.col(moving) == scratch.col(moving)) continue;  // not lifted: Provot's pass holds it
             const Vec3 d = x.col(moving) - x.col(pinned);
             const Real length = d.norm(), l = aim * reach * warp.rest_m[s];
             if (length > l) x.col(moving) = x.col(pinned) + d * (l / length);
