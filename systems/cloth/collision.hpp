@@ -10,16 +10,17 @@
 //      max(r_min (|y| - 1), max_i r_i (|y_i| - 1)). Everything is measured in the anchor's
 //      rigid frame against references: each particle's position when its whole list was
 //      last refreshed (its move since: d_p) and each ellipsoid's pose when its bit was last
-//      refreshed (its move since, D_e <= |dc| + |dL|_F of its unit-sphere map). A
-//      particle's budget is the clearance of its reference point from the nearest unlisted
-//      reference ellipsoid; while d_p + max_e D_e <= budget no unlisted ellipsoid can
-//      contain it. An ellipsoid that has moved half the margin gets its bit refreshed in
-//      every list (a fast shin often, the pelvis rarely; blocks of particles whose box is
-//      far from it are cleared untested), which can only lower budgets; a particle whose
-//      budget is spent gets its whole list refreshed. What is left of the budget is the
-//      particle's slack for step 3.
-//   2. Detection: ellipsoids the particle collided with last substep are tested first
-//      (temporal coherence), then the rest of its list; brute force tests every ellipsoid.
+//      refreshed (its move since, D_e <= |dc| + |dL|_F of its unit-sphere map). Each
+//      particle keeps C_pe, the clearance of its reference point from each unlisted
+//      reference ellipsoid; while d_p + D_e < C_pe for every unlisted e, none of them can
+//      contain it. An ellipsoid that has moved half the margin gets its bit (and C_pe)
+//      refreshed in every list (a fast shin often, the pelvis rarely; blocks of particles
+//      whose box is far from it are cleared untested); a particle with no slack left,
+//      min_e (C_pe - D_e) - d_p, gets its whole list refreshed. The slack is kept for step 3.
+//   2. Detection: in list mode 8 consecutive particles are tested at once against every
+//      ellipsoid of their lists (vector lanes outside a particle's list are discarded and not
+//      counted); brute force tests every ellipsoid. Last substep's contacts are answered
+//      first (temporal coherence).
 //   3. Response for each hit, last-collided first: move the particle to where the line
 //      from the centre through it meets the surface, x = c + (x - c) / |y|, and remove the
 //      velocity component along the surface normal relative to the surface's own motion
