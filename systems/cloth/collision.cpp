@@ -415,7 +415,15 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             for (Eigen::Index l = 0; l < count; ++l)
                 if (inv_mass[p + l] != 0) block_lists[static_cast<std::size_t>(l)] = (*candidates)[pi + static_cast<std::size_t>(l)] & active;
             detect_block(x, p, count, frames, block_lists, block_hits);
+            for (Eigen::Index l = 0; l < count; ++l) {  // the particles without a hit are done
+                const std::size_t li = static_cast<std::size_t>(l);
+                r.tests += static_cast<std::uint64_t>(std::popcount(block_lists[li]));
+                if (block_hits[li] != 0) continue;
+                last_collided[pi + li] = 0;
+                if (detected) (*detected)[pi + li] = 0;
+            }
         }
+        if (candidates && block_hits[static_cast<std::size_t>(p % detect_lanes)] == 0) continue;
         if (inv_mass[p] == 0) {
             last_collided[pi] = 0;
             continue;
@@ -425,7 +433,6 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         Vec3 xp = x.col(p);
         std::uint64_t hits = 0;
         if (candidates) {
-            r.tests += static_cast<std::uint64_t>(std::popcount(list));
             hits = block_hits[static_cast<std::size_t>(p % detect_lanes)];
         } else {
             for_each_bit(list, [&](int e) {
