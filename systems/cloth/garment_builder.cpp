@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <string>
 
 #include "components/ellipsoid_collider.hpp"
@@ -23,7 +24,18 @@ std::string field(std::string_view prefix, std::string_view name) {
     return std::string(prefix) + "." + std::string(name);
 }
 
-bool finite_positive(Real v) { return std::isfinite(v) && v > 0; }
+// A number as a user would write it (0.55, 1e+30, nan); std::to_string prints 0.000000 for 1e-30.
+std::string number(Real v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+// In (0, hi] (or [0, hi] when zero is allowed), finite. The upper bounds are those of the
+// scene files' garment parameters (game/scene_file.cpp): beyond them float arithmetic, not
+// the cloth, decides what happens.
+bool in_range(Real v, Real hi, bool zero_allowed = false) {
+    return std::isfinite(v) && (zero_allowed ? v >= 0 : v > 0) && v <= hi;
+}
 
 Result<void> validate_grid(std::string_view p, int lines, int per_line, int stride, bool closed) {
     if (lines < 2 || lines > 4096) return fail(field(p, "warp_lines") + ": must be in [2, 4096], got " + std::to_string(lines));
@@ -50,17 +62,17 @@ Result<void> validate_tube(std::string_view p, int lines, int per_line, int stri
                            std::string_view height_m_name, Real torso_fraction, int fitting_rows,
                            const ClothMaterial& material) {
     if (auto ok = validate_grid(p, lines, per_line, stride, true); !ok) return ok;
-    if (!finite_positive(length)) return fail(field(p, "length_m") + ": must be > 0, got " + std::to_string(length));
+    if (!in_range(length, 10)) return fail(field(p, "length_m") + ": must be in (0, 10] m, got " + number(length));
     if (!std::isfinite(flare_deg) || flare_deg < 0 || flare_deg > 80)
-        return fail(field(p, "flare_deg") + ": must be in [0, 80], got " + std::to_string(flare_deg));
+        return fail(field(p, "flare_deg") + ": must be in [0, 80], got " + number(flare_deg));
     if (!std::isfinite(ease) || ease < 0 || ease > 1)
-        return fail(field(p, "ease_m") + ": must be in [0, 1], got " + std::to_string(ease));
+        return fail(field(p, "ease_m") + ": must be in [0, 1], got " + number(ease));
     if (!std::isfinite(height_fraction) || height_fraction <= 0 || height_fraction >= 1)
-        return fail(field(p, height_fraction_name) + ": must be in (0, 1), got " + std::to_string(height_fraction));
-    if (!std::isfinite(height_m) || height_m < 0)
-        return fail(field(p, height_m_name) + ": must be >= 0 (0 = from the fraction), got " + std::to_string(height_m));
-    if (!finite_positive(torso_fraction))
-        return fail(field(p, "torso_radius_fraction") + ": must be > 0, got " + std::to_string(torso_fraction));
+        return fail(field(p, height_fraction_name) + ": must be in (0, 1), got " + number(height_fraction));
+    if (!in_range(height_m, 10, true))
+        return fail(field(p, height_m_name) + ": must be in [0, 10] m (0 = from the fraction), got " + number(height_m));
+    if (!in_range(torso_fraction, 1))
+        return fail(field(p, "torso_radius_fraction") + ": must be in (0, 1], got " + number(torso_fraction));
     if (fitting_rows < 1 || fitting_rows >= per_line)
         return fail(field(p, "fitting_rows") + ": must be in [1, particles_per_line), got " + std::to_string(fitting_rows));
     return validate(material, field(p, "material"));
@@ -254,7 +266,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
         outline.push_back(e);
     }
     if (outline.empty())
-        return fail(p + ": no collider crosses the ring height " + std::to_string(ring_y) + " m near the body axis");
+        return fail(p + ": no collider crosses the ring height " + number(ring_y) + " m near the body axis");
 
     const int n = s.lines, m = s.per_line;
     const Real step = s.length_m / Real(m - 1);
@@ -288,21 +300,21 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
 }  // namespace
 
 Result<void> validate(const ClothMaterial& m, std::string_view p) {
-    if (!finite_positive(m.mass_kg)) return fail(field(p, "mass_kg") + ": must be > 0, got " + std::to_string(m.mass_kg));
-    if (!finite_positive(m.stretch_k_N_m))
-        return fail(field(p, "stretch_k_N_m") + ": must be > 0, got " + std::to_string(m.stretch_k_N_m));
-    if (!std::isfinite(m.shear_k_N_m) || m.shear_k_N_m < 0)
-        return fail(field(p, "shear_k_N_m") + ": must be >= 0, got " + std::to_string(m.shear_k_N_m));
-    if (!std::isfinite(m.bend_k_N_m) || m.bend_k_N_m < 0)
-        return fail(field(p, "bend_k_N_m") + ": must be >= 0, got " + std::to_string(m.bend_k_N_m));
-    if (!std::isfinite(m.drag_N_s_m) || m.drag_N_s_m < 0)
-        return fail(field(p, "drag_N_s_m") + ": must be >= 0, got " + std::to_string(m.drag_N_s_m));
+    if (!in_range(m.mass_kg, 100)) return fail(field(p, "mass_kg") + ": must be in (0, 100], got " + number(m.mass_kg));
+    if (!in_range(m.stretch_k_N_m, 1e7))
+        return fail(field(p, "stretch_k_N_m") + ": must be in (0, 1e7], got " + number(m.stretch_k_N_m));
+    if (!in_range(m.shear_k_N_m, 1e7, true))
+        return fail(field(p, "shear_k_N_m") + ": must be in [0, 1e7], got " + number(m.shear_k_N_m));
+    if (!in_range(m.bend_k_N_m, 1e7, true))
+        return fail(field(p, "bend_k_N_m") + ": must be in [0, 1e7], got " + number(m.bend_k_N_m));
+    if (!in_range(m.drag_N_s_m, 100, true))
+        return fail(field(p, "drag_N_s_m") + ": must be in [0, 100], got " + number(m.drag_N_s_m));
     if (!std::isfinite(m.strain_limit) || m.strain_limit <= 0 || m.strain_limit > 10)
-        return fail(field(p, "strain_limit") + ": must be in (0, 10], got " + std::to_string(m.strain_limit));
+        return fail(field(p, "strain_limit") + ": must be in (0, 10], got " + number(m.strain_limit));
     if (m.strain_iterations < 0 || m.strain_iterations > 100)
         return fail(field(p, "strain_iterations") + ": must be in [0, 100], got " + std::to_string(m.strain_iterations));
-    if (!finite_positive(m.candidate_margin_m))
-        return fail(field(p, "candidate_margin_m") + ": must be > 0, got " + std::to_string(m.candidate_margin_m));
+    if (!in_range(m.candidate_margin_m, 1))
+        return fail(field(p, "candidate_margin_m") + ": must be in (0, 1] m, got " + number(m.candidate_margin_m));
     return {};
 }
 
@@ -320,9 +332,11 @@ Result<void> validate(const DressParams& s) {
 
 Result<void> validate(const RectangleParams& r) {
     if (auto ok = validate_grid("rectangle", r.warp_lines, r.particles_per_line, r.weft_stride, false); !ok) return ok;
-    if (!finite_positive(r.width_m)) return fail("rectangle.width_m: must be > 0, got " + std::to_string(r.width_m));
-    if (!finite_positive(r.length_m)) return fail("rectangle.length_m: must be > 0, got " + std::to_string(r.length_m));
-    if (!r.origin.allFinite()) return fail("rectangle.origin: must be finite");
+    if (!in_range(r.width_m, 100)) return fail("rectangle.width_m: must be in (0, 100] m, got " + number(r.width_m));
+    if (!in_range(r.length_m, 100)) return fail("rectangle.length_m: must be in (0, 100] m, got " + number(r.length_m));
+    // Beyond 10 km a float position keeps less than a millimetre.
+    if (!r.origin.allFinite() || r.origin.cwiseAbs().maxCoeff() > Real(1e4))
+        return fail("rectangle.origin: must be finite and within 10 km of the world origin");
     return validate(r.material, "rectangle.material");
 }
 
