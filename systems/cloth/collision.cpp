@@ -472,7 +472,10 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             for (int round = 0; round < max_retest_rounds && moved; ++round) {
                 moved = false;
                 if ((xp - x_detected).squaredNorm() > slack_sq) retest = active;
-                for_each_bit(retest, [&](int e) {
+                // A single contact leaves its ellipsoid outside by construction (place_on_surface):
+                // the first round tests only the others.
+                const std::uint64_t left = round == 0 && std::popcount(hits) == 1 ? hits : 0;
+                for_each_bit(retest & ~left, [&](int e) {
                     ++r.tests;
                     moved = respond(e) || moved;
                 });
