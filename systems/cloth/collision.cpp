@@ -239,7 +239,17 @@ struct PointBounds {
 // set where a point is within `margin` of the ellipsoid, cleared elsewhere. With `clearance`
 // (one per point), stores each unlisted point's clearance from the ellipsoid, +inf for the
 // listed ones.
-std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const ListEllipsoid& f, std::size_t e,
+// Bounds of the whole point set, then of each block of `candidate_block` points.
+struct BlockBounds {
+    PointBounds all;
+    std::vector<PointBounds> blocks;
+    explicit BlockBounds(const Matrix3X& x) : all(x) {
+        for (Eigen::Index begin = 0; begin < x.cols(); begin += candidate_block)
+            blocks.emplace_back(x.middleCols(begin, std::min<Eigen::Index>(candidate_block, x.cols() - begin)));
+    }
+};
+
+std::uint64_t refresh_bit(const Matrix3X& x, const BlockBounds& bounds, const ListEllipsoid& f, std::size_t e,
                           Real margin, std::vector<std::uint64_t>& candidates, Real* clearance_out) {
     const Eigen::Index n = x.cols();
     const std::uint64_t bit = std::uint64_t(1) << e;
@@ -247,7 +257,7 @@ std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const Li
     Real* b = clearance_out;
     constexpr Real listed = std::numeric_limits<Real>::infinity();
     // Broad phase, whole garment then blocks: a gap between the boxes bounds every distance.
-    if (const Real gap = bounds.gap(f); gap > margin) {
+    if (const Real gap = bounds.all.gap(f); gap > margin) {
         for (Eigen::Index i = 0; i < n; ++i) out[i] &= ~bit;
         if (b)
             for (Eigen::Index i = 0; i < n; ++i) b[i] = gap - clearance_rounding_m;
@@ -259,7 +269,7 @@ std::uint64_t refresh_bit(const Matrix3X& x, const PointBounds& bounds, const Li
     for (Eigen::Index begin = 0; begin < n; begin += candidate_block) {
         const Eigen::Index count = std::min<Eigen::Index>(candidate_block, n - begin);
         const auto block = x.middleCols(begin, count);
-        if (const Real gap = PointBounds(block).gap(f); gap > margin) {
+        if (const Real gap = bounds.blocks[static_cast<std::size_t>(begin / candidate_block)].gap(f); gap > margin) {
             for (Eigen::Index i = begin; i < begin + count; ++i) out[i] &= ~bit;
             if (b)
                 for (Eigen::Index i = begin; i < begin + count; ++i) b[i] = gap - clearance_rounding_m;
@@ -383,7 +393,7 @@ std::uint64_t refresh_candidate_bit(const Matrix3X& x, std::span<const Ellipsoid
         for (std::uint64_t& c : candidates) c &= ~(std::uint64_t(1) << e);
         return 0;
     }
-    return refresh_bit(x, PointBounds(x), ListEllipsoid(frames[e]), e, margin, candidates, nullptr);
+    return refresh_bit(x, BlockBounds(x), ListEllipsoid(frames[e]), e, margin, candidates, nullptr);
 }
 
 std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
@@ -588,7 +598,7 @@ void update_candidate_lists(Garment& g) {
 
     // 2. Ellipsoids: refresh bit e against the particles' reference points when e has moved
     //    its share since its reference pose, which it then becomes. D_e: its move since.
-    std::optional<PointBounds> bounds;  // of the reference points, on first use
+    std::optional<BlockBounds> bounds;  // of the reference points, on first use
     const Real ellipsoid_limit = ellipsoid_refresh_share * margin;
     std::array<Real, 64> moved_since{};
     for (std::size_t e = 0; e < e_count; ++e) {
