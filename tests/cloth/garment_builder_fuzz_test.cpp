@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <string>
@@ -39,6 +40,7 @@ TEST(GarmentBuilderFuzz, RandomRectanglesBuildAndStayFiniteOrGiveOneError) {
     const std::array<int, 9> per_line{-1, 0, 1, 2, 3, 8, 16, 30, 700001};
     const std::array<int, 6> strides{-1, 0, 1, 2, 3, 7};
     int built = 0, refused = 0;
+    std::uint64_t resets = 0;  // recorded, not required: extreme but valid materials may be reset
     for (int i = 0; i < 300; ++i) {
         RectangleParams p;
         if (rng() % 2 == 0) {  // a valid grid, so that the other fields get tried
@@ -85,9 +87,11 @@ TEST(GarmentBuilderFuzz, RandomRectanglesBuildAndStayFiniteOrGiveOneError) {
         for (int frame = 0; frame < 3; ++frame) ASSERT_TRUE(scheduler.tick(registry, 1.0 / 60.0));
         EXPECT_TRUE(g.x.allFinite()) << "case " << i;
         EXPECT_TRUE(g.v.allFinite()) << "case " << i;
+        resets += g.counters.resets;
     }
     RecordProperty("built", built);
     RecordProperty("refused", refused);
+    RecordProperty("resets", static_cast<int>(resets));
     // Both outcomes occur, so neither branch above is dead.
     EXPECT_GT(built, 50);
     EXPECT_GT(refused, 100);
