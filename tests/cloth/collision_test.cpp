@@ -160,6 +160,51 @@ std::array<std::uint64_t, 3> compare_with_brute_force(ClothModel model, const Dr
     return {contacts, list_tests, brute_tests};
 }
 
+// Detection tests blocks of 8 particles in vector lanes; it must agree with the single
+// unit-sphere test for every particle, including a last block that is not full and pinned
+// particles (never reported).
+TEST(Collision, BlockDetectionAgreesWithTheUnitSphereTestOfEachParticle) {
+    std::vector<EllipsoidFrame> frames{tilted_ellipsoid()};
+    Affine3 t = Affine3::Identity();
+    t.translate(Vec3(0.35f, 1.15f, -0.3f));
+    t.scale(Vec3(0.15f, 0.25f, 0.1f));
+    frames.push_back(make_ellipsoid_frame(t));
+    frames.push_back(frames[0]);
+    frames.back().active = false;  // an inactive collider is never reported
+    const Eigen::Index n = 8 * 40 + 5;
+    std::uint32_t state = 12345;
+    const auto next = [&state] {
+        state = state * 1664525u + 1013904223u;
+        return Real(state >> 8) / Real(1 << 24);
+    };
+    Matrix3X x(3, n);
+    VectorX inv_mass = VectorX::Ones(n);
+    for (Eigen::Index p = 0; p < n; ++p) {
+        x.col(p) = Vec3(0.3f, 1.2f, -0.4f) + Real(0.8) * Vec3(next() - Real(0.5), next() - Real(0.5), next() - Real(0.5));
+        if (p % 17 == 0) inv_mass[p] = 0;
+    }
+    const DetectedPairs found = detect_brute_force(x, inv_mass, frames);
+    int hits = 0, checked = 0;
+    for (Eigen::Index p = 0; p < n; ++p) {
+        const std::uint64_t bits = found[static_cast<std::size_t>(p)];
+        if (inv_mass[p] == 0) {
+            EXPECT_EQ(bits, 0u) << "pinned particle " << p;
+            continue;
+        }
+        EXPECT_EQ(bits & 4u, 0u) << "inactive collider, particle " << p;
+        for (std::size_t e = 0; e < 2; ++e) {
+            const Real y_sq = to_unit_sphere(frames[e], x.col(p)).squaredNorm();
+            if (std::abs(y_sq - 1) < Real(1e-5)) continue;  // a float rounding apart from the surface
+            ++checked;
+            const bool inside = y_sq < 1;
+            hits += inside;
+            EXPECT_EQ((bits >> e) & 1u, inside ? 1u : 0u) << "particle " << p << " ellipsoid " << e;
+        }
+    }
+    EXPECT_GT(hits, 20);
+    EXPECT_GT(checked - hits, 20);
+}
+
 TEST(CandidateLists, ARefreshedBitHoldsEveryPointWithinTheMarginAndOnlyItsBitChanges) {
     const EllipsoidFrame f = tilted_ellipsoid();
     const std::vector<EllipsoidFrame> frames = {tilted_ellipsoid(), f};  // refresh bit 1
