@@ -12,6 +12,8 @@
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
 #include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth/garment_step.hpp"
+#include "systems/cloth/substeps.hpp"
 
 namespace drape::test {
 
@@ -143,5 +145,36 @@ struct WalkingScene {
     AnalyticBody body;
     Scheduler scheduler;
 };
+
+// Steps garment `g` on `body` by hand for `frames` fixed 1/60 s steps, each split into the
+// cloth's substeps (method §3.4) and run in the cloth systems' order: integrate, constrain,
+// `after_constraints(g, ctx, frame)`, then `collide(g, ctx, frame)` (by default the
+// collision system's step), so that tests can look between the systems.
+template <class After, class Collide>
+void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, int frames, After&& after_constraints,
+                  Collide&& collide) {
+    const double dt = 1.0 / 60.0;
+    for (int frame = 0; frame < frames; ++frame) {
+        body.place(registry, (frame + 1) * dt, false, dt);
+        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
+        FrameContext ctx;
+        ctx.fixed_dt_s = dt;
+        ctx.substeps = substeps;
+        ctx.h_s = dt / substeps;
+        for (int s = 0; s < substeps; ++s) {
+            ctx.substep = s;
+            integrate_garment(registry, g, ctx);
+            constrain_garment(g, ctx);
+            after_constraints(g, ctx, frame);
+            collide(g, ctx, frame);
+        }
+    }
+}
+
+template <class After>
+void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, int frames, After&& after_constraints) {
+    step_by_hand(body, registry, g, frames, after_constraints,
+                 [&](Garment& garment, const FrameContext& ctx, int) { collide_garment_step(registry, garment, ctx); });
+}
 
 }  // namespace drape::test

@@ -115,26 +115,16 @@ void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dr
     test::AnalyticBody body(registry, walk);
     const Entity e = dress(registry, body.character, model, mode);
     Garment& g = registry.get<Garment>(e);
-    const double dt = 1.0 / 60.0;
-    const int frames = static_cast<int>(walk.period_s / dt) + 1;
-    for (int frame = 0; frame < frames; ++frame) {
-        body.place(registry, (frame + 1) * dt, false, dt);
-        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
-        FrameContext ctx;
-        ctx.fixed_dt_s = dt;
-        ctx.substeps = substeps;
-        ctx.h_s = dt / substeps;
-        for (int s = 0; s < substeps; ++s) {
-            ctx.substep = s;
-            integrate_garment(registry, g, ctx);
-            constrain_garment(g, ctx);
-            update_frames(registry, g, Real(s + 1) / Real(substeps));
-            check(g, /*before=*/true);
-            const CollisionResult r = collide_garment(g, nullptr, static_cast<Real>(ctx.h_s));
-            g.counters.unresolved += r.unresolved;
-            check(g, /*before=*/false);
-        }
-    }
+    const int frames = static_cast<int>(walk.period_s / (1.0 / 60.0)) + 1;
+    test::step_by_hand(
+        body, registry, g, frames, [](Garment&, const FrameContext&, int) {},
+        [&](Garment& garment, const FrameContext& ctx, int) {
+            update_frames(registry, garment, Real(ctx.substep + 1) / Real(ctx.substeps));
+            check(garment, /*before=*/true);
+            const CollisionResult r = collide_garment(garment, nullptr, static_cast<Real>(ctx.h_s));
+            garment.counters.unresolved += r.unresolved;
+            check(garment, /*before=*/false);
+        });
 }
 
 // Detection with lists + last-collided first, compared pair for pair with brute force on

@@ -12,27 +12,6 @@
 namespace drape {
 namespace {
 
-// Runs `frames` fixed steps by hand, calling `after_constraints` after each constraint pass.
-template <class F>
-void walk(test::AnalyticBody& body, Registry& registry, Garment& g, int frames, F&& after_constraints) {
-    const double dt = 1.0 / 60.0;
-    for (int frame = 0; frame < frames; ++frame) {
-        body.place(registry, (frame + 1) * dt, false, dt);
-        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
-        FrameContext ctx;
-        ctx.fixed_dt_s = dt;
-        ctx.substeps = substeps;
-        ctx.h_s = dt / substeps;
-        for (int s = 0; s < substeps; ++s) {
-            ctx.substep = s;
-            integrate_garment(registry, g, ctx);
-            constrain_garment(g, ctx);
-            after_constraints(g, ctx);
-            collide_garment_step(registry, g, ctx);
-        }
-    }
-}
-
 // Asserts that every warp spring with at least one free end is within 1.10 x rest (between
 // two pinned particles the skin decides); returns how many layer-2 warp springs hanging from
 // a pinned particle it checked.
@@ -67,7 +46,7 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringLongerThanTenPercentAfterTheConstra
     Garment& g = registry.get<Garment>(e);
     int checks = 0;
     std::size_t below_pins = 0;
-    walk(body, registry, g, 120, [&](Garment& garment, const FrameContext&) {
+    test::step_by_hand(body, registry, g, 120, [&](Garment& garment, const FrameContext&, int) {
         if (::testing::Test::HasFailure()) return;
         below_pins += expect_warp_within_limit(garment);
         ++checks;
@@ -91,7 +70,7 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringOfAWalkingDressLongerThanTenPercent
     const GarmentTopology& t = *g.topology;
     Matrix3X normals(3, t.layer1_count);
     std::size_t on_planes = 0;
-    walk(body, registry, g, simplified ? 120 : 60, [&](Garment& garment, const FrameContext&) {
+    test::step_by_hand(body, registry, g, simplified ? 120 : 60, [&](Garment& garment, const FrameContext&, int) {
         if (::testing::Test::HasFailure()) return;
         below_pins += expect_warp_within_limit(garment);
         ++checks;
@@ -117,7 +96,7 @@ TEST_P(ConstraintOnWalkingSkirt, PinnedParticlesAreNeverMovedByTheConstraints) {
     params.model = GetParam();
     const Entity e = *attach_skirt(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
-    walk(body, registry, g, 30, [&](Garment& garment, const FrameContext& ctx) {
+    test::step_by_hand(body, registry, g, 30, [&](Garment& garment, const FrameContext& ctx, int) {
         if (ctx.substep + 1 < ctx.substeps) return;  // mid-step pins are between two targets
         for (Eigen::Index i = 0; i < garment.pin_target.cols(); ++i)
             ASSERT_EQ(garment.x.col(garment.pins[static_cast<std::size_t>(i)].particle), garment.pin_target.col(i));
@@ -136,7 +115,7 @@ TEST(Weft, LayerTwoParticlesLieOnTheirPlanesAfterTheConstraintSystem) {
     const GarmentTopology& t = *g.topology;
     Matrix3X normals(3, t.layer1_count);
     std::size_t checked = 0;
-    walk(body, registry, g, 90, [&](Garment& garment, const FrameContext&) {
+    test::step_by_hand(body, registry, g, 90, [&](Garment& garment, const FrameContext&, int) {
         compute_layer1_normals(t, garment.x, normals);
         for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
             if (garment.inv_mass[t.weft_particle[k]] == 0) continue;

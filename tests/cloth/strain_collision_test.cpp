@@ -67,34 +67,26 @@ TEST(StrainCollision, WalkingSkirtPushOutsStayShorterThanTheLargestRadius) {
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
     const GarmentTopology& t = *g.topology;
-    const double dt = 1.0 / 60.0;
     Real farthest = 0, worst_strain = 0;
-    for (int frame = 0; frame < 132; ++frame) {  // two walk cycles
-        body.place(registry, (frame + 1) * dt, false, dt);
-        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
-        FrameContext ctx;
-        ctx.fixed_dt_s = dt;
-        ctx.substeps = substeps;
-        ctx.h_s = dt / substeps;
-        for (int s = 0; s < substeps; ++s) {
-            ctx.substep = s;
-            integrate_garment(registry, g, ctx);
-            constrain_garment(g, ctx);
-            const Matrix3X before = g.x;
-            collide_garment_step(registry, g, ctx);
-            ASSERT_EQ(g.counters.resets, 0u);
+    Matrix3X before;
+    test::step_by_hand(
+        body, registry, g, 132,  // two walk cycles
+        [&](Garment& garment, const FrameContext&, int) { before = garment.x; },
+        [&](Garment& garment, const FrameContext& ctx, int frame) {
+            collide_garment_step(registry, garment, ctx);
+            ASSERT_EQ(garment.counters.resets, 0u);
             Real largest_radius = 0;
-            for (const EllipsoidFrame& f : g.frames) largest_radius = std::max(largest_radius, f.radii_m.maxCoeff());
-            for (Eigen::Index p = 0; p < g.x.cols(); ++p) {
-                const Real move = (g.x.col(p) - before.col(p)).norm();
+            for (const EllipsoidFrame& f : garment.frames) largest_radius = std::max(largest_radius, f.radii_m.maxCoeff());
+            for (Eigen::Index p = 0; p < garment.x.cols(); ++p) {
+                const Real move = (garment.x.col(p) - before.col(p)).norm();
                 farthest = std::max(farthest, move);
                 ASSERT_LE(move, largest_radius) << "particle " << p << " frame " << frame;
             }
             for (const SpringPhase* phase : {&t.warp1, &t.warp2, &t.weft})
                 for (std::size_t k = 0; k < phase->size(); ++k)
-                    worst_strain = std::max(worst_strain, (g.x.col(phase->b[k]) - g.x.col(phase->a[k])).norm() / phase->rest_m[k] - 1);
-        }
-    }
+                    worst_strain = std::max(
+                        worst_strain, (garment.x.col(phase->b[k]) - garment.x.col(phase->a[k])).norm() / phase->rest_m[k] - 1);
+        });
     RecordProperty("farthest_push_out_m", std::to_string(farthest));
     RecordProperty("worst_strain_after_collision", std::to_string(worst_strain));
 }

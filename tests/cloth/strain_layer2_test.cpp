@@ -25,27 +25,6 @@ constexpr Real tolerance = Real(1 + 1e-5);
 constexpr Real slack_m = Real(1e-6);
 constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
 
-// Runs `frames` fixed steps, calling `after_constraints` after each constraint pass.
-template <class F>
-void walk(test::AnalyticBody& body, Registry& registry, Garment& g, int frames, F&& after_constraints) {
-    const double dt = 1.0 / 60.0;
-    for (int frame = 0; frame < frames; ++frame) {
-        body.place(registry, (frame + 1) * dt, false, dt);
-        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
-        FrameContext ctx;
-        ctx.fixed_dt_s = dt;
-        ctx.substeps = substeps;
-        ctx.h_s = dt / substeps;
-        for (int s = 0; s < substeps; ++s) {
-            ctx.substep = s;
-            integrate_garment(registry, g, ctx);
-            constrain_garment(g, ctx);
-            after_constraints(g);
-            collide_garment_step(registry, g, ctx);
-        }
-    }
-}
-
 // Counts of what was checked.
 struct Checked {
     std::size_t warp = 0, weft = 0;
@@ -87,7 +66,9 @@ TEST(StrainLayer2, WalkingSkirtHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
     Checked checked;
-    walk(body, registry, g, 150, [&](Garment& garment) { expect_layer2_bounds(garment, garment.material.strain_limit, checked); });
+    test::step_by_hand(body, registry, g, 150, [&](Garment& garment, const FrameContext&, int) {
+        expect_layer2_bounds(garment, garment.material.strain_limit, checked);
+    });
     EXPECT_GT(checked.warp, 50000u);
     EXPECT_GT(checked.weft, 100000u);
 }
@@ -98,7 +79,9 @@ TEST(StrainLayer2, WalkingDressHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem
     const Entity e = *attach_dress(registry, body.character, DressParams{});
     Garment& g = registry.get<Garment>(e);
     Checked checked;
-    walk(body, registry, g, 40, [&](Garment& garment) { expect_layer2_bounds(garment, garment.material.strain_limit, checked); });
+    test::step_by_hand(body, registry, g, 40, [&](Garment& garment, const FrameContext&, int) {
+        expect_layer2_bounds(garment, garment.material.strain_limit, checked);
+    });
     EXPECT_GT(checked.warp, 200000u);
 }
 
