@@ -549,14 +549,6 @@ EllipsoidFrame in_anchor_frame(const EllipsoidFrame& f, const Affine3& anchor) {
     return a;
 }
 
-// Unit sphere -> frame map of an ellipsoid frame.
-Affine3 unit_map(const EllipsoidFrame& f) {
-    Affine3 t = Affine3::Identity();
-    t.linear() = f.rotation * f.radii_m.asDiagonal();
-    t.translation() = f.center;
-    return t;
-}
-
 // How far any point of the ellipsoid `then` can be from its image in `now`: |dc| + |dL|_F
 // (|dL u| <= |dL|_F for |u| <= 1).
 Real ellipsoid_move(const Affine3& now, const Affine3& then) {
@@ -612,7 +604,7 @@ void update_candidate_lists(Garment& g) {
             continue;
         }
         const EllipsoidFrame current = in_anchor_frame(g.frames[e], anchor);
-        const Affine3 now = unit_map(current);
+        const Affine3 now = unit_to_world(current);
         const Real moved = has_reference(then) ? ellipsoid_move(now, then) : std::numeric_limits<Real>::infinity();
         if (moved <= ellipsoid_limit) {
             moved_since[e] = moved;
