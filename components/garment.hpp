@@ -173,11 +173,11 @@ struct Garment {
     std::vector<std::uint64_t> candidates;   ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
     std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep.
     bool lists_valid = false;                ///< False: rebuild the candidate lists before the next test.
-    Matrix3X list_anchor_x;                  ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
+    Matrix3XRows list_anchor_x;              ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
     std::vector<Affine3> list_anchor_frames; ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed (zero: none).
     Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> list_clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
     VectorX list_slack_m;                    ///< Per particle: how far it may still move before its list could miss a collider, after the last list update, m.
-    Matrix3X list_scratch;                   ///< Anchor-frame positions, reused by the list bookkeeping every substep.
+    Matrix3XRows list_scratch;               ///< Anchor-frame positions, reused by the list bookkeeping every substep.
 
     GarmentCounters counters;
 

@@ -5,8 +5,13 @@
 // rounding. Poses and the scheduler's clock use double where accumulated time matters.
 #pragma once
 
+// GCC 12 warns inside its own AVX-512 intrinsics, which Eigen uses for 16-float vectors
+// (-Wmaybe-uninitialized on the intrinsics' placeholder operand: GCC bug 105593, fixed in 13).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#pragma GCC diagnostic pop
 
 namespace drape {
 
@@ -18,7 +23,9 @@ using Mat3 = Eigen::Matrix<Real, 3, 3>;
 using Mat4 = Eigen::Matrix<Real, 4, 4>;
 using Quat = Eigen::Quaternion<Real>;
 using Affine3 = Eigen::Transform<Real, 3, Eigen::Affine>;
-using Matrix3X = Eigen::Matrix<Real, 3, Eigen::Dynamic>;  ///< Structure of arrays: one column per point.
+using Matrix3X = Eigen::Matrix<Real, 3, Eigen::Dynamic>;  ///< One column per point (x, y, z adjacent).
+/// One contiguous row per coordinate (structure of arrays): whole-row vector arithmetic.
+using Matrix3XRows = Eigen::Matrix<Real, 3, Eigen::Dynamic, Eigen::RowMajor>;
 using Matrix4X = Eigen::Matrix<Real, 4, Eigen::Dynamic>;
 using VectorX = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 using Vec4i = Eigen::Matrix<int, 4, 1>;

@@ -26,8 +26,9 @@ constexpr int max_retest_rounds = 4;
 
 // Where a particle at unit-sphere image y leaves the ellipsoid along its centre line
 // (method §5): on the surface plus a clearance. At the centre there is no centre line; it
-// leaves along the longest axis. Returns the unit-sphere image of the new place.
-inline Vec3 place_on_surface(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x) {
+// leaves along the longest axis. Returns the unit-sphere image of the new place. `outside`:
+// 1 + surface_clearance(f).
+inline Vec3 place_on_surface(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x, Real outside) {
     Vec3 y = y_in;
     Real length = y.norm();
     if (length <= Real(1e-6)) {
@@ -36,7 +37,7 @@ inline Vec3 place_on_surface(const EllipsoidFrame& f, const Vec3& y_in, Vec3& x)
         y = Vec3::Unit(axis);
         length = 1;
     }
-    const Vec3 y_surface = y * ((1 + surface_clearance(f)) / length);
+    const Vec3 y_surface = y * (outside / length);
     x = f.center + f.rotation * f.radii_m.cwiseProduct(y_surface);
     return y_surface;
 }
@@ -50,10 +51,11 @@ constexpr Real shallow_share = Real(0.25);
 // elongated ellipsoid (a thigh the hem swung into) the centre line runs along the long axis
 // and would carry the particle tens of centimetres toward the knee; the normal leaves by
 // the short side. Returns the unit-sphere image of the new place.
-inline Vec3 place_shortest(const EllipsoidFrame& f, const Vec3& y, Vec3& x) {
-    const Real y_sq = y.squaredNorm();
+// `y` = to_unit (x - c) with y_sq = |y|^2 < 1, inv_len = 1 / |y|; `along_centre` = the
+// centre-line push-out, |x - c| (1 / |y| - 1).
+inline Vec3 place_shortest(const EllipsoidFrame& f, const Vec3& y, Real y_sq, Real inv_len, Real along_centre, Vec3& x,
+                           Real outside) {
     if (y_sq > Real(1e-12)) {
-        const Real along_centre = (x - f.center).norm() * (1 / std::sqrt(y_sq) - 1);
         if (along_centre > shallow_share * f.radii_m.minCoeff()) {
             // Along the normal n = L^T y (L = to_unit): the unit-sphere image moves along d = L n,
             // |y + s d| = 1 at s = -2c / (b + sqrt(b^2 - 4ac)) with a = |d|^2, b = 2 y.d = 2 |n|^2,
@@ -62,15 +64,32 @@ inline Vec3 place_shortest(const EllipsoidFrame& f, const Vec3& y, Vec3& x) {
             const Vec3 d = f.to_unit * n;
             const Real a = d.squaredNorm(), b = 2 * n.squaredNorm(), c = y_sq - 1;
             const Real s = -2 * c / (b + std::sqrt(b * b - 4 * a * c));
-            if (s * n.norm() < along_centre) return place_on_surface(f, y + s * d, x);
+            if (s * n.norm() < along_centre) return place_on_surface(f, y + s * d, x, outside);
         }
+        // Along the centre line: x - c = R diag(r) y scales with y.
+        const Real scale = outside * inv_len;
+        x = f.center + (x - f.center) * scale;
+        return y * scale;
     }
-    return place_on_surface(f, y, x);
+    return place_on_surface(f, y, x, outside);
+}
+
+// How far the centre-line response moves a point inside (offset d = x - c, y_sq = |y|^2 < 1).
+inline Real centre_line_depth(const EllipsoidFrame& f, const Vec3& d, Real y_sq) {
+    const Real y_len = std::sqrt(y_sq);
+    return y_len > Real(1e-6) ? d.norm() * (1 / y_len - 1) : f.radii_m.minCoeff();
+}
+
+// Outward unit normal at the point with unit-sphere image y (not the centre): L^T y, normalised.
+inline Vec3 surface_normal(const EllipsoidFrame& f, const Vec3& y) {
+    const Vec3 g = f.to_unit.transpose() * y;
+    const Real length_sq = g.squaredNorm();
+    return length_sq > 0 ? Vec3(g * (1 / std::sqrt(length_sq))) : g;
 }
 
 // Inelastic contact (method §5): no velocity into the surface, relative to its motion.
 inline void remove_approach(const EllipsoidFrame& f, const Vec3& y_surface, const Vec3& x, Vec3& v) {
-    const Vec3 normal = (f.to_unit.transpose() * y_surface).normalized();
+    const Vec3 normal = surface_normal(f, y_surface);
     const Vec3 surface_velocity = body_velocity_at(f, x);
     const Real approach = (v - surface_velocity).dot(normal);
     if (approach < 0) v -= approach * normal;
@@ -85,9 +104,9 @@ inline void for_each_bit(std::uint64_t bits, F&& f) {
     }
 }
 
-// ---- Detection (method §5): the unit-sphere test, 8 consecutive particles at a time.
+// ---- Detection (method §5): the unit-sphere test, 16 consecutive particles at a time.
 
-constexpr Eigen::Index detect_lanes = 8;
+constexpr Eigen::Index detect_lanes = 16;
 using DetectLanes = Eigen::Array<Real, detect_lanes, 1>;
 using LaneBits = std::array<std::uint64_t, detect_lanes>;
 
@@ -114,6 +133,7 @@ inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index cou
         const DetectLanes y1 = m(1, 0) * d0 + m(1, 1) * d1 + m(1, 2) * d2;
         const DetectLanes y2 = m(2, 0) * d0 + m(2, 1) * d1 + m(2, 2) * d2;
         const DetectLanes y_sq = y0 * y0 + y1 * y1 + y2 * y2;
+        if (y_sq.minCoeff() >= 1) return;  // the common case: no lane inside
         const std::uint64_t bit = std::uint64_t(1) << e;
         for (std::size_t l = 0; l < static_cast<std::size_t>(detect_lanes); ++l)
             hits[l] |= y_sq[static_cast<Eigen::Index>(l)] < 1 ? tested[l] & bit : 0;
@@ -149,140 +169,171 @@ struct ListEllipsoid {
     }
 };
 
-// Lower bounds of the distances from points to an ellipsoid, from their unit-sphere
-// coordinates y (3 x k): the unit-sphere map stretches distances by at most 1 / r_min, and
-// the ellipsoid lies inside its box of half sizes r_i in its own axes. Negative inside.
-template <class Y>
-inline auto clearance_of(const Y& y, const Vec3& radii) {
-    const auto box = ((y.array().abs() - 1).colwise() * radii.array()).colwise().maxCoeff();
-    return (radii.minCoeff() * (y.colwise().norm().array() - 1)).max(box);
+// Lower bound of the distance from a point to an ellipsoid, from its unit-sphere
+// coordinates y: the unit-sphere map stretches distances by at most 1 / r_min, and the
+// ellipsoid lies inside its box of half sizes r_i in its own axes. Negative inside.
+inline Real clearance_of(Real y0, Real y1, Real y2, Real r0, Real r1, Real r2, Real r_min) {
+    const Real box = std::max(std::max(r0 * (std::abs(y0) - 1), r1 * (std::abs(y1) - 1)), r2 * (std::abs(y2) - 1));
+    return std::max(r_min * (std::sqrt(y0 * y0 + y1 * y1 + y2 * y2) - 1), box);
 }
 
-// Ellipsoids as structure of arrays, 8 to a chunk, to test one point against all of them
-// in a few vector instructions (a particle's whole list). Unused lanes hold an ellipsoid
-// 1e18 m away: never listed, never the nearest.
-class EllipsoidLanes {
+// The reference ellipsoids of a list update as structure of arrays, lane e = ellipsoid e,
+// so that one point is tested against all of them in a few vector instructions (a
+// particle's whole list refresh). A lane without an active ellipsoid holds one 1e18 m away
+// and reports +inf.
+class ReferenceLanes {
 public:
-    void add(const ListEllipsoid& f, int e) {
-        const int chunk = m_count / width, lane = m_count % width;
-        if (lane == 0) m_chunks[static_cast<std::size_t>(chunk)] = Chunk{};
-        Chunk& c = m_chunks[static_cast<std::size_t>(chunk)];
-        for (int i = 0; i < 9; ++i) c.to_unit[static_cast<std::size_t>(i)][lane] = f.to_unit(i / 3, i % 3);
-        for (int i = 0; i < 3; ++i) {
-            c.offset[static_cast<std::size_t>(i)][lane] = f.offset[i];
-            c.radii[static_cast<std::size_t>(i)][lane] = f.radii[i];
-        }
-        c.r_min[lane] = f.radii.minCoeff();
-        c.bit[static_cast<std::size_t>(lane)] = std::uint64_t(1) << e;
-        ++m_count;
-    }
-    [[nodiscard]] bool empty() const noexcept { return m_count == 0; }
+    static constexpr std::size_t max_lanes = 64;
 
-    // Sets `bits` to the ellipsoids within `margin` of x and `out[e]` to the clearance
-    // (clearance_of) of each other ellipsoid e, +inf for the listed ones.
-    void test(const Vec3& x, Real margin, std::uint64_t& bits, std::array<Real, 64>& out) const {
-        bits = 0;
-        for (int k = 0; k * width < m_count; ++k) {
-            const Chunk& c = m_chunks[static_cast<std::size_t>(k)];
-            const Lanes y0 = c.to_unit[0] * x[0] + c.to_unit[1] * x[1] + c.to_unit[2] * x[2] - c.offset[0];
-            const Lanes y1 = c.to_unit[3] * x[0] + c.to_unit[4] * x[1] + c.to_unit[5] * x[2] - c.offset[1];
-            const Lanes y2 = c.to_unit[6] * x[0] + c.to_unit[7] * x[1] + c.to_unit[8] * x[2] - c.offset[2];
-            const Lanes sphere = c.r_min * ((y0 * y0 + y1 * y1 + y2 * y2).sqrt() - 1);  // as clearance_of
-            const Lanes box0 = c.radii[0] * (y0.abs() - 1), box1 = c.radii[1] * (y1.abs() - 1), box2 = c.radii[2] * (y2.abs() - 1);
-            const Lanes clearance = sphere.max(box0).max(box1.max(box2));
-            const auto listed = clearance <= margin;
-            const Lanes unlisted = listed.select(Lanes::Constant(std::numeric_limits<Real>::infinity()), clearance);
-            for (int l = 0; l < width && k * width + l < m_count; ++l) {
-                const std::uint64_t bit = c.bit[static_cast<std::size_t>(l)];
-                out[static_cast<std::size_t>(std::countr_zero(bit))] = unlisted[l];
-                bits |= listed[l] ? bit : 0;
-            }
+    explicit ReferenceLanes(std::size_t count)
+        : m_lanes(static_cast<int>(std::min<std::size_t>((count + 15) / 16 * 16, max_lanes))) {
+        for (auto& a : m_to_unit) a.fill(0);
+        for (auto& a : m_offset) a.fill(0);
+        for (auto& a : m_radii) a.fill(1);
+        m_offset[0].fill(Real(-1e18));
+        m_r_min.fill(1);
+        m_moved.fill(0);
+        m_inactive.fill(infinity);
+    }
+
+    // Ellipsoid e as the reference, its unit sphere -> reference frame map `t` = [R diag(r) | c]
+    // (so its unit-sphere map is diag(1/r^2) L^T (x - c), L = R diag(r)), moved `moved` since (D_e).
+    void set(std::size_t e, const Affine3& t, Real moved) {
+        const Mat3 l = t.linear();
+        const Vec3 radii = l.colwise().norm().transpose();
+        const Mat3 to_unit = radii.cwiseAbs2().cwiseInverse().asDiagonal() * l.transpose();
+        const Vec3 offset = to_unit * t.translation();
+        for (std::size_t i = 0; i < 9; ++i) m_to_unit[i][e] = to_unit(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3));
+        for (std::size_t i = 0; i < 3; ++i) {
+            m_offset[i][e] = offset[static_cast<Eigen::Index>(i)];
+            m_radii[i][e] = radii[static_cast<Eigen::Index>(i)];
         }
+        m_r_min[e] = radii.minCoeff();
+        m_moved[e] = moved;
+        m_inactive[e] = 0;
+    }
+
+    // Lists the ellipsoids within `margin` of x (the returned bits), leaves in `stored[e]`
+    // each one's clearance (clearance_of) less the rounding allowance, +inf where listed or
+    // inactive, and returns min_e (stored[e] - D_e).
+    std::uint64_t test(const Vec3& x, Real margin, std::array<Real, max_lanes>& stored, Real& left) const {
+        const Real p0 = x[0], p1 = x[1], p2 = x[2];
+        for (int l = 0; l < m_lanes; ++l) {  // vectorised: one lane per ellipsoid
+            const auto& m = m_to_unit;
+            const Real y0 = m[0][l] * p0 + m[1][l] * p1 + m[2][l] * p2 - m_offset[0][l];
+            const Real y1 = m[3][l] * p0 + m[4][l] * p1 + m[5][l] * p2 - m_offset[1][l];
+            const Real y2 = m[6][l] * p0 + m[7][l] * p1 + m[8][l] * p2 - m_offset[2][l];
+            const Real d = clearance_of(y0, y1, y2, m_radii[0][l], m_radii[1][l], m_radii[2][l], m_r_min[l]);
+            stored[static_cast<std::size_t>(l)] = (d <= margin ? infinity : d - clearance_rounding_m) + m_inactive[l];
+        }
+        using Lanes = Eigen::Map<const Eigen::Array<Real, 16, 1>, Eigen::Aligned64>;  // register-wide reductions
+        left = infinity;
+        for (int k = 0; k < m_lanes; k += 16) left = std::min(left, (Lanes(stored.data() + k) - Lanes(m_moved.data() + k)).minCoeff());
+        std::uint64_t bits = 0;
+        for (int l = 0; l < m_lanes; ++l)  // an OR reduction of vector lanes
+            bits |= stored[static_cast<std::size_t>(l)] == infinity && m_inactive[l] == 0 ? lane_bit[static_cast<std::size_t>(l)] : 0;
+        return bits;
     }
 
 private:
-    static constexpr int width = 8;
-    using Lanes = Eigen::Array<Real, width, 1>;
-    struct Chunk {
-        std::array<Lanes, 9> to_unit{Lanes::Zero(), Lanes::Zero(), Lanes::Zero(), Lanes::Zero(), Lanes::Zero(),
-                                     Lanes::Zero(), Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
-        std::array<Lanes, 3> offset{Lanes::Constant(Real(-1e18)), Lanes::Zero(), Lanes::Zero()};
-        std::array<Lanes, 3> radii{Lanes::Ones(), Lanes::Ones(), Lanes::Ones()};
-        Lanes r_min = Lanes::Ones();
-        std::array<std::uint64_t, width> bit{};
-    };
-    std::array<Chunk, 64 / width> m_chunks;
-    int m_count = 0;
+    static constexpr Real infinity = std::numeric_limits<Real>::infinity();
+    static constexpr std::array<std::uint64_t, max_lanes> lane_bit = [] {
+        std::array<std::uint64_t, max_lanes> bits{};
+        for (std::size_t l = 0; l < max_lanes; ++l) bits[l] = std::uint64_t(1) << l;
+        return bits;
+    }();
+    using Row = std::array<Real, max_lanes>;
+    int m_lanes;
+    alignas(64) std::array<Row, 9> m_to_unit;
+    alignas(64) std::array<Row, 3> m_offset;
+    alignas(64) std::array<Row, 3> m_radii;
+    alignas(64) Row m_r_min;
+    alignas(64) Row m_moved;
+    alignas(64) Row m_inactive;  ///< 0 for a lane with an ellipsoid, else +inf.
 };
-
-// Unit-sphere coordinates of a block of points (rows contiguous: whole-row arithmetic) and
-// one value per point.
-using BlockPoints = Eigen::Matrix<Real, 3, Eigen::Dynamic, 0, 3, candidate_block>;
-using BlockValues = Eigen::Array<Real, 1, Eigen::Dynamic, Eigen::RowMajor, 1, candidate_block>;
 
 // Bounding box of points.
 struct PointBounds {
     Vec3 low = Vec3::Constant(std::numeric_limits<Real>::infinity());
     Vec3 high = Vec3::Constant(-std::numeric_limits<Real>::infinity());
-    template <class X>
-    explicit PointBounds(const X& x) {
-        for (Eigen::Index i = 0; i < x.cols(); ++i) {
-            low = low.cwiseMin(x.col(i));
-            high = high.cwiseMax(x.col(i));
+    PointBounds() = default;
+    // Of points [begin, begin + count) of x: whole rows at once.
+    PointBounds(const Matrix3XRows& x, Eigen::Index begin, Eigen::Index count) {
+        for (int i = 0; i < 3; ++i) {
+            const Real* row = x.row(i).data() + begin;
+            if (count == candidate_block) {  // fixed size: register-wide reductions
+                const Eigen::Map<const Eigen::Array<Real, candidate_block, 1>> block(row);
+                low[i] = block.minCoeff();
+                high[i] = block.maxCoeff();
+            } else {
+                for (Eigen::Index k = 0; k < count; ++k) {
+                    low[i] = std::min(low[i], row[k]);
+                    high[i] = std::max(high[i], row[k]);
+                }
+            }
         }
+    }
+    void add(const PointBounds& o) {
+        low = low.cwiseMin(o.low);
+        high = high.cwiseMax(o.high);
     }
     // Lower bound of the distance between a point inside and the ellipsoid `f`.
     [[nodiscard]] Real gap(const ListEllipsoid& f) const { return (f.low - high).cwiseMax(low - f.high).maxCoeff(); }
 };
 
-// Refreshes bit e of the lists of points x (any frame; `f` and `bounds` in the same frame):
-// set where a point is within `margin` of the ellipsoid, cleared elsewhere. With `clearance`
-// (one per point), stores each unlisted point's clearance from the ellipsoid, +inf for the
-// listed ones.
-// Bounds of the whole point set, then of each block of `candidate_block` points.
+// Bounds of the whole point set, and of each block of `candidate_block` points.
 struct BlockBounds {
     PointBounds all;
     std::vector<PointBounds> blocks;
-    explicit BlockBounds(const Matrix3X& x) : all(x) {
-        for (Eigen::Index begin = 0; begin < x.cols(); begin += candidate_block)
-            blocks.emplace_back(x.middleCols(begin, std::min<Eigen::Index>(candidate_block, x.cols() - begin)));
+    explicit BlockBounds(const Matrix3XRows& x) {
+        const Eigen::Index n = x.cols();
+        blocks.reserve(static_cast<std::size_t>((n + candidate_block - 1) / candidate_block));
+        for (Eigen::Index begin = 0; begin < n; begin += candidate_block) {
+            blocks.emplace_back(x, begin, std::min<Eigen::Index>(candidate_block, n - begin));
+            all.add(blocks.back());
+        }
     }
 };
 
-std::uint64_t refresh_bit(const Matrix3X& x, const BlockBounds& bounds, const ListEllipsoid& f, std::size_t e,
-                          Real margin, std::vector<std::uint64_t>& candidates, Real* clearance_out) {
+// Refreshes bit e of the lists of points x (any frame; `f` and `bounds` in the same frame):
+// set where a point is within `margin` of the ellipsoid, cleared elsewhere, and stores in
+// `clearance` (one per point) each unlisted point's clearance from the ellipsoid, +inf for
+// the listed ones. Returns the tests done.
+std::uint64_t refresh_bit(const Matrix3XRows& x, const BlockBounds& bounds, const ListEllipsoid& f, std::size_t e,
+                          Real margin, std::vector<std::uint64_t>& candidates, Real* clearance) {
     const Eigen::Index n = x.cols();
     const std::uint64_t bit = std::uint64_t(1) << e;
     std::uint64_t* out = candidates.data();
-    Real* b = clearance_out;
     constexpr Real listed = std::numeric_limits<Real>::infinity();
     // Broad phase, whole garment then blocks: a gap between the boxes bounds every distance.
     if (const Real gap = bounds.all.gap(f); gap > margin) {
         for (Eigen::Index i = 0; i < n; ++i) out[i] &= ~bit;
-        if (b)
-            for (Eigen::Index i = 0; i < n; ++i) b[i] = gap - clearance_rounding_m;
+        std::fill(clearance, clearance + n, gap - clearance_rounding_m);
         return 0;
     }
+    const Real* x0 = x.row(0).data();
+    const Real* x1 = x.row(1).data();
+    const Real* x2 = x.row(2).data();
+    const Mat3& m = f.to_unit;
+    const Real r0 = f.radii[0], r1 = f.radii[1], r2 = f.radii[2], r_min = f.radii.minCoeff();
     std::uint64_t tests = 0;
-    BlockPoints y;
-    BlockValues clearance;
     for (Eigen::Index begin = 0; begin < n; begin += candidate_block) {
-        const Eigen::Index count = std::min<Eigen::Index>(candidate_block, n - begin);
-        const auto block = x.middleCols(begin, count);
+        const Eigen::Index end = std::min<Eigen::Index>(begin + candidate_block, n);
         if (const Real gap = bounds.blocks[static_cast<std::size_t>(begin / candidate_block)].gap(f); gap > margin) {
-            for (Eigen::Index i = begin; i < begin + count; ++i) out[i] &= ~bit;
-            if (b)
-                for (Eigen::Index i = begin; i < begin + count; ++i) b[i] = gap - clearance_rounding_m;
+            for (Eigen::Index i = begin; i < end; ++i) out[i] &= ~bit;
+            std::fill(clearance + begin, clearance + end, gap - clearance_rounding_m);
             continue;
         }
-        y.noalias() = f.to_unit * block;
-        y.colwise() -= f.offset;
-        clearance = clearance_of(y, f.radii);
-        for (Eigen::Index i = 0; i < count; ++i) out[begin + i] = clearance[i] <= margin ? out[begin + i] | bit : out[begin + i] & ~bit;
-        if (b)
-            for (Eigen::Index i = 0; i < count; ++i)
-                b[begin + i] = clearance[i] <= margin ? listed : clearance[i] - clearance_rounding_m;
-        tests += static_cast<std::uint64_t>(count);
+        for (Eigen::Index i = begin; i < end; ++i) {  // vectorised: one lane per point
+            const Real y0 = m(0, 0) * x0[i] + m(0, 1) * x1[i] + m(0, 2) * x2[i] - f.offset[0];
+            const Real y1 = m(1, 0) * x0[i] + m(1, 1) * x1[i] + m(1, 2) * x2[i] - f.offset[1];
+            const Real y2 = m(2, 0) * x0[i] + m(2, 1) * x1[i] + m(2, 2) * x2[i] - f.offset[2];
+            const Real d = clearance_of(y0, y1, y2, r0, r1, r2, r_min);
+            const bool near = d <= margin;
+            out[i] = near ? out[i] | bit : out[i] & ~bit;
+            clearance[i] = near ? listed : d - clearance_rounding_m;
+        }
+        tests += static_cast<std::uint64_t>(end - begin);
     }
     return tests;
 }
@@ -367,15 +418,13 @@ inline Vec3 fallback_exit(std::span<const EllipsoidFrame> frames, std::uint64_t 
 }  // namespace
 
 Real penetration_depth(const EllipsoidFrame& f, const Vec3& x) {
-    const Real y_sq = to_unit_sphere(f, x).squaredNorm();
-    if (y_sq >= 1) return 0;
-    const Real y = std::sqrt(y_sq);
-    if (y <= Real(1e-6)) return f.radii_m.minCoeff();
-    return (x - f.center).norm() * (1 / y - 1);
+    const Vec3 d = x - f.center;
+    const Real y_sq = (f.to_unit * d).squaredNorm();
+    return y_sq >= 1 ? 0 : centre_line_depth(f, d, y_sq);
 }
 
 void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
-    remove_approach(f, place_on_surface(f, y, x), x, v);
+    remove_approach(f, place_on_surface(f, y, x, 1 + surface_clearance(f)), x, v);
 }
 
 std::uint64_t active_mask(std::span<const EllipsoidFrame> frames) {
@@ -393,7 +442,9 @@ std::uint64_t refresh_candidate_bit(const Matrix3X& x, std::span<const Ellipsoid
         for (std::uint64_t& c : candidates) c &= ~(std::uint64_t(1) << e);
         return 0;
     }
-    return refresh_bit(x, BlockBounds(x), ListEllipsoid(frames[e]), e, margin, candidates, nullptr);
+    const Matrix3XRows rows = x;
+    VectorX clearance(x.cols());
+    return refresh_bit(rows, BlockBounds(rows), ListEllipsoid(frames[e]), e, margin, candidates, clearance.data());
 }
 
 std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
@@ -414,60 +465,42 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
     if (detected) detected->assign(static_cast<std::size_t>(n), 0);
     const std::uint64_t active = active_mask(frames);
     const bool whole_move = x_start != nullptr && h > 0;
+    const Real inv_h = whole_move ? 1 / h : 0;
+    std::array<Real, 64> outside{};  // per ellipsoid: 1 + surface_clearance, once per pass
+    for_each_bit(active, [&](int e) { outside[static_cast<std::size_t>(e)] = 1 + surface_clearance(frames[static_cast<std::size_t>(e)]); });
 
-    LaneBits block_lists{}, block_hits{};
-    for (Eigen::Index p = 0; p < n; ++p) {
+    // Response for one particle and the ellipsoids `hits` (not empty) found to contain it.
+    auto collide_one = [&](Eigen::Index p, std::uint64_t hits) {
         const std::size_t pi = static_cast<std::size_t>(p);
-        if (candidates && p % detect_lanes == 0) {
-            // List mode: the lists of the next block of particles at once (detect_block).
-            const Eigen::Index count = std::min(detect_lanes, n - p);
-            block_lists.fill(0);
-            for (Eigen::Index l = 0; l < count; ++l)
-                if (inv_mass[p + l] != 0) block_lists[static_cast<std::size_t>(l)] = (*candidates)[pi + static_cast<std::size_t>(l)] & active;
-            detect_block(x, p, count, frames, block_lists, block_hits);
-            for (Eigen::Index l = 0; l < count; ++l) {  // the particles without a hit are done
-                const std::size_t li = static_cast<std::size_t>(l);
-                r.tests += static_cast<std::uint64_t>(std::popcount(block_lists[li]));
-                if (block_hits[li] != 0) continue;
-                last_collided[pi + li] = 0;
-                if (detected) (*detected)[pi + li] = 0;
-            }
-        }
-        if (candidates && block_hits[static_cast<std::size_t>(p % detect_lanes)] == 0) continue;
-        if (inv_mass[p] == 0) {
-            last_collided[pi] = 0;
-            continue;
-        }
         const std::uint64_t list = (candidates ? (*candidates)[pi] : ~std::uint64_t(0)) & active;
         const std::uint64_t last = last_collided[pi] & list;
         Vec3 xp = x.col(p);
-        std::uint64_t hits = 0;
-        if (candidates) {
-            hits = block_hits[static_cast<std::size_t>(p % detect_lanes)];
-        } else {
-            for_each_bit(list, [&](int e) {
-                ++r.tests;
-                if (to_unit_sphere(frames[static_cast<std::size_t>(e)], xp).squaredNorm() < 1) hits |= std::uint64_t(1) << e;
-            });
-        }
-        for_each_bit(hits, [&](int e) {
-            const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
-            const Real y_len = to_unit_sphere(f, xp).norm();
-            const Real depth = y_len > Real(1e-6) ? (xp - f.center).norm() * (1 / y_len - 1) : f.radii_m.minCoeff();
-            r.max_penetration_m = std::max(r.max_penetration_m, depth);
+        // The first contact answered is measured on the way (below); any other at the detected place.
+        const int first = std::countr_zero((hits & last) != 0 ? hits & last : hits);
+        for_each_bit(hits & ~(std::uint64_t(1) << first), [&](int e) {
+            r.max_penetration_m = std::max(r.max_penetration_m, penetration_depth(frames[static_cast<std::size_t>(e)], xp));
         });
         if (detected) (*detected)[pi] = hits;
         last_collided[pi] = hits;
-        if (hits == 0) continue;
 
         Vec3 vp = v.col(p);
         const Vec3 x_detected = xp;
-        auto respond = [&](int e) {
+        int responses = 0, last_e = -1;
+        Vec3 last_y_surface = Vec3::Zero();
+        auto respond = [&](int e) __attribute__((always_inline)) {
             const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
-            const Vec3 y = to_unit_sphere(f, xp);
-            if (y.squaredNorm() >= 1) return false;
-            const Vec3 y_surface = place_shortest(f, y, xp);
-            if (!whole_move) remove_approach(f, y_surface, xp, vp);  // else from the whole move, below
+            const Vec3 d = xp - f.center;
+            const Vec3 y = f.to_unit * d;
+            const Real y_sq = y.squaredNorm();
+            if (y_sq >= 1) return false;
+            const Real y_len = std::sqrt(y_sq);
+            const Real inv_len = 1 / y_len;
+            const Real depth = y_len > Real(1e-6) ? d.norm() * (inv_len - 1) : f.radii_m.minCoeff();  // centre_line_depth
+            if (responses == 0 && e == first) r.max_penetration_m = std::max(r.max_penetration_m, depth);
+            last_y_surface = place_shortest(f, y, y_sq, inv_len, depth, xp, outside[static_cast<std::size_t>(e)]);
+            if (!whole_move) remove_approach(f, last_y_surface, xp, vp);  // else from the whole move, below
+            last_e = e;
+            ++responses;
             ++r.collisions;
             return true;
         };
@@ -477,6 +510,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         const Real slack = list_slack.size() == static_cast<std::size_t>(n) ? list_slack[pi] : std::numeric_limits<Real>::infinity();
         const Real slack_sq = slack * slack;
         std::uint64_t retest = (xp - x_detected).squaredNorm() > slack_sq ? active : list;
+        bool fell_back = false;
         if (std::popcount(retest) > 1 || retest != list) {
             bool moved = true;
             for (int round = 0; round < max_retest_rounds && moved; ++round) {
@@ -496,6 +530,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                 // past every ellipsoid the way crosses (fallback_exit).
                 xp = fallback_exit(frames, active, x_detected, hits, xp,
                                    x_start != nullptr ? Vec3(x_start->col(p)) : x_detected);
+                fell_back = true;
                 Real depth = 0;
                 for_each_bit(active, [&](int e) {
                     ++r.tests;
@@ -506,16 +541,62 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         }
         if (whole_move) {
             // Velocity of the whole move, then no normal velocity relative to any surface touched.
-            vp = (xp - x_start->col(p)) / h;
+            // A single push-out (the common case) left xp where last_y_surface maps.
+            vp = (xp - x_start->col(p)) * inv_h;
+            const bool single = responses == 1 && !fell_back;
             for_each_bit(last_collided[pi], [&](int e) {
                 const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
-                const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, xp)).normalized();
+                const Vec3 normal = surface_normal(f, single && e == last_e ? last_y_surface : to_unit_sphere(f, xp));
                 const Vec3 surface_velocity = body_velocity_at(f, xp);
                 vp -= (vp - surface_velocity).dot(normal) * normal;
             });
         }
         x.col(p) = xp;
         v.col(p) = vp;
+    };
+
+    if (candidates) {
+        // List mode: 16 particles at a time against the ellipsoids of their lists (detect_block).
+        LaneBits block_lists{}, block_hits{};
+        for (Eigen::Index begin = 0; begin < n; begin += detect_lanes) {
+            const Eigen::Index count = std::min(detect_lanes, n - begin);
+            const std::size_t bi = static_cast<std::size_t>(begin);
+            block_lists.fill(0);
+            std::uint64_t any = 0;
+            for (Eigen::Index l = 0; l < count; ++l) {
+                const std::size_t li = static_cast<std::size_t>(l);
+                if (inv_mass[begin + l] != 0) block_lists[li] = (*candidates)[bi + li] & active;
+                r.tests += static_cast<std::uint64_t>(std::popcount(block_lists[li]));
+                any |= block_lists[li];
+            }
+            block_hits.fill(0);
+            if (any != 0) detect_block(x, begin, count, frames, block_lists, block_hits);
+            for (Eigen::Index l = 0; l < count; ++l) {
+                const std::size_t li = static_cast<std::size_t>(l);
+                if (block_hits[li] != 0) {
+                    collide_one(begin + l, block_hits[li]);
+                } else {
+                    last_collided[bi + li] = 0;
+                    if (detected) (*detected)[bi + li] = 0;
+                }
+            }
+        }
+    } else {
+        // Brute force: every particle against every ellipsoid.
+        for (Eigen::Index p = 0; p < n; ++p) {
+            std::uint64_t hits = 0;
+            if (inv_mass[p] != 0) {
+                const Vec3 xp = x.col(p);
+                for_each_bit(active, [&](int e) {
+                    ++r.tests;
+                    if (to_unit_sphere(frames[static_cast<std::size_t>(e)], xp).squaredNorm() < 1) hits |= std::uint64_t(1) << e;
+                });
+            }
+            if (hits != 0)
+                collide_one(p, hits);
+            else
+                last_collided[static_cast<std::size_t>(p)] = 0;
+        }
     }
     return r;
 }
@@ -571,10 +652,23 @@ void update_candidate_lists(Garment& g) {
     std::uint64_t tests = 0;
 
     // 1. Each particle's position and move d_p in the anchor frame (whole arrays).
-    Matrix3X& local = g.list_scratch;
+    Matrix3XRows& local = g.list_scratch;
     local.resize(3, n);
-    local.noalias() = to_anchor * g.x;
-    local.colwise() -= to_anchor * anchor.translation();
+    {
+        // One pass with stride-3 loads; the rows of `local` are contiguous.
+        const Vec3 t = anchor.translation();
+        const Real* x = g.x.data();
+        Real* l0 = local.row(0).data();
+        Real* l1 = local.row(1).data();
+        Real* l2 = local.row(2).data();
+        const Mat3& r = to_anchor;
+        for (Eigen::Index p = 0; p < n; ++p) {
+            const Real a = x[3 * p] - t[0], b = x[3 * p + 1] - t[1], c = x[3 * p + 2] - t[2];
+            l0[p] = r(0, 0) * a + r(0, 1) * b + r(0, 2) * c;
+            l1[p] = r(1, 0) * a + r(1, 1) * b + r(1, 2) * c;
+            l2[p] = r(2, 0) * a + r(2, 1) * b + r(2, 2) * c;
+        }
+    }
     const bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
                        clearance.rows() == n && clearance.cols() == static_cast<Eigen::Index>(e_count) &&
                        g.candidates.size() == static_cast<std::size_t>(n);
@@ -586,7 +680,10 @@ void update_candidate_lists(Garment& g) {
         ++g.counters.list_rebuilds;
     }
     slack.resize(n);
-    slack = (local - g.list_anchor_x).colwise().norm().transpose();
+    {
+        const auto d = (local - g.list_anchor_x).array();
+        slack = (d.row(0).square() + d.row(1).square() + d.row(2).square()).sqrt().transpose();
+    }
 
     // 2. Ellipsoids: refresh bit e against the particles' reference points when e has moved
     //    its share since its reference pose, which it then becomes. D_e: its move since.
@@ -597,7 +694,7 @@ void update_candidate_lists(Garment& g) {
         Affine3& then = g.list_anchor_frames[e];
         if (!g.frames[e].active) {
             if (has_reference(then)) {
-                tests += refresh_candidate_bit(g.list_anchor_x, g.frames, e, margin, g.candidates);  // clears it
+                for (std::uint64_t& c : g.candidates) c &= ~(std::uint64_t(1) << e);
                 clearance.col(static_cast<Eigen::Index>(e)).setConstant(std::numeric_limits<Real>::infinity());
                 then.matrix().setZero();
             }
@@ -629,25 +726,33 @@ void update_candidate_lists(Garment& g) {
         for (Eigen::Index p = 0; p < n; ++p) r[p] = std::min(r[p], c[p] - moved);
     });
     slack = room - slack;
-    EllipsoidLanes references;  // filled on first use
-    std::array<Real, 64> particle_clearance{};
-    for (Eigen::Index p = 0; p < n; ++p) {
-        if (slack[p] >= 0 || g.inv_mass[p] == 0) continue;  // pinned: never tested (method §3.5)
-        if (references.empty()) {
+    std::optional<ReferenceLanes> references;  // on first use
+    alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
+    // The particles without slack, gathered without a branch per particle; pinned ones are
+    // never tested (method §3.5).
+    std::vector<Eigen::Index> spent(static_cast<std::size_t>(n));
+    std::size_t spent_count = 0;
+    for (Eigen::Index begin = 0; begin < n; begin += 16) {
+        const Eigen::Index end = std::min<Eigen::Index>(begin + 16, n);
+        if (end - begin == 16 && Eigen::Map<const Eigen::Array<Real, 16, 1>>(slack.data() + begin).minCoeff() >= 0) continue;
+        for (Eigen::Index p = begin; p < end; ++p) {
+            spent[spent_count] = p;
+            spent_count += static_cast<std::size_t>(slack[p] < 0) & static_cast<std::size_t>(g.inv_mass[p] != 0);
+        }
+    }
+    for (std::size_t k = 0; k < spent_count; ++k) {
+        const Eigen::Index p = spent[k];
+        if (!references) {
+            references.emplace(e_count);
             for_each_bit(active, [&](int e) {
-                references.add(ListEllipsoid(make_ellipsoid_frame(g.list_anchor_frames[static_cast<std::size_t>(e)])), e);
+                const std::size_t ei = static_cast<std::size_t>(e);
+                references->set(ei, g.list_anchor_frames[ei], moved_since[ei]);
             });
         }
         g.list_anchor_x.col(p) = local.col(p);
-        std::uint64_t bits = 0;
-        references.test(local.col(p), margin, bits, particle_clearance);
-        g.candidates[static_cast<std::size_t>(p)] = bits;
-        Real left = std::numeric_limits<Real>::infinity();
-        for_each_bit(active, [&](int e) {
-            const std::size_t ei = static_cast<std::size_t>(e);
-            clearance(p, e) = particle_clearance[ei] - clearance_rounding_m;
-            left = std::min(left, clearance(p, e) - moved_since[ei]);
-        });
+        Real left = 0;
+        g.candidates[static_cast<std::size_t>(p)] = references->test(local.col(p), margin, stored, left);
+        for (std::size_t e = 0; e < e_count; ++e) clearance(p, static_cast<Eigen::Index>(e)) = stored[e];
         slack[p] = std::max(Real(0), left);
         tests += static_cast<std::uint64_t>(std::popcount(active));
     }
