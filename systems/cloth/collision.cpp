@@ -104,9 +104,9 @@ inline void for_each_bit(std::uint64_t bits, F&& f) {
     }
 }
 
-// ---- Detection (method §5): the unit-sphere test, 16 consecutive particles at a time.
+// ---- Detection (method §5): the unit-sphere test, 64 consecutive particles at a time.
 
-constexpr Eigen::Index detect_lanes = 16;
+constexpr Eigen::Index detect_lanes = 64;
 using DetectLanes = Eigen::Array<Real, detect_lanes, 1>;
 using LaneBits = std::array<std::uint64_t, detect_lanes>;
 
@@ -556,7 +556,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
     };
 
     if (candidates) {
-        // List mode: 16 particles at a time against the ellipsoids of their lists (detect_block).
+        // List mode: 64 particles at a time against the ellipsoids of their lists (detect_block).
         LaneBits block_lists{}, block_hits{};
         for (Eigen::Index begin = 0; begin < n; begin += detect_lanes) {
             const Eigen::Index count = std::min(detect_lanes, n - begin);

@@ -150,7 +150,7 @@ std::array<std::uint64_t, 3> compare_with_brute_force(ClothModel model, const Dr
     return {contacts, list_tests, brute_tests};
 }
 
-// Detection tests blocks of 8 particles in vector lanes; it must agree with the single
+// Detection tests blocks of 64 particles in vector lanes; it must agree with the single
 // unit-sphere test for every particle, including a last block that is not full and pinned
 // particles (never reported).
 TEST(Collision, BlockDetectionAgreesWithTheUnitSphereTestOfEachParticle) {
@@ -161,7 +161,7 @@ TEST(Collision, BlockDetectionAgreesWithTheUnitSphereTestOfEachParticle) {
     frames.push_back(make_ellipsoid_frame(t));
     frames.push_back(frames[0]);
     frames.back().active = false;  // an inactive collider is never reported
-    const Eigen::Index n = 8 * 40 + 5;
+    const Eigen::Index n = 64 * 5 + 5;  // a last block that is not full
     std::uint32_t state = 12345;
     const auto next = [&state] {
         state = state * 1664525u + 1013904223u;
