@@ -114,7 +114,7 @@ using LaneBits = std::array<std::uint64_t, detect_lanes>;
 // (|y| < 1). Every ellipsoid in any of the lists is tested against the whole block in one
 // pass of vector instructions; lanes whose list leaves it out are discarded. Brute force's
 // reference detection uses the same arithmetic, so both agree to the bit.
-inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index count,
+inline bool detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index count,
                          std::span<const EllipsoidFrame> frames, const LaneBits& tested, LaneBits& hits) {
     DetectLanes p0 = DetectLanes::Zero(), p1 = DetectLanes::Zero(), p2 = DetectLanes::Zero();
     std::uint64_t any = 0;
@@ -125,6 +125,7 @@ inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index cou
         any |= tested[static_cast<std::size_t>(l)];
     }
     hits.fill(0);
+    bool found = false;  // some lane inside some ellipsoid (a lane outside its list may be one)
     for_each_bit(any, [&](int e) {
         const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
         const Mat3& m = f.to_unit;
@@ -134,10 +135,12 @@ inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index cou
         const DetectLanes y2 = m(2, 0) * d0 + m(2, 1) * d1 + m(2, 2) * d2;
         const DetectLanes y_sq = y0 * y0 + y1 * y1 + y2 * y2;
         if (y_sq.minCoeff() >= 1) return;  // the common case: no lane inside
+        found = true;
         const std::uint64_t bit = std::uint64_t(1) << e;
         for (std::size_t l = 0; l < static_cast<std::size_t>(detect_lanes); ++l)
             hits[l] |= y_sq[static_cast<Eigen::Index>(l)] < 1 ? tested[l] & bit : 0;
     });
+    return found;
 }
 
 // ---- Candidate lists (method §5, spatial locality); see collision.hpp step 1.
@@ -148,7 +151,7 @@ inline void detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index cou
 constexpr Real ellipsoid_refresh_share = Real(0.5);
 // Particles per block in a bit refresh; a block whose bounding box is farther than the
 // margin from the ellipsoid's box is cleared without a test.
-constexpr Eigen::Index candidate_block = 32;
+constexpr Eigen::Index candidate_block = 64;
 // Clearances are lowered by this much so that float rounding cannot turn a bound into a miss.
 constexpr Real clearance_rounding_m = Real(1e-5);
 
@@ -187,13 +190,14 @@ public:
 
     explicit ReferenceLanes(std::size_t count)
         : m_lanes(static_cast<int>(std::min<std::size_t>((count + 15) / 16 * 16, max_lanes))) {
-        for (auto& a : m_to_unit) a.fill(0);
-        for (auto& a : m_offset) a.fill(0);
-        for (auto& a : m_radii) a.fill(1);
-        m_offset[0].fill(Real(-1e18));
-        m_r_min.fill(1);
-        m_moved.fill(0);
-        m_inactive.fill(infinity);
+        const auto lanes = static_cast<std::size_t>(m_lanes);  // the lanes used, not all of max_lanes
+        for (auto& a : m_to_unit) std::fill_n(a.begin(), lanes, Real(0));
+        for (auto& a : m_offset) std::fill_n(a.begin(), lanes, Real(0));
+        for (auto& a : m_radii) std::fill_n(a.begin(), lanes, Real(1));
+        std::fill_n(m_offset[0].begin(), lanes, Real(-1e18));
+        std::fill_n(m_r_min.begin(), lanes, Real(1));
+        std::fill_n(m_moved.begin(), lanes, Real(0));
+        std::fill_n(m_inactive.begin(), lanes, infinity);
     }
 
     // Ellipsoid e as the reference, its unit sphere -> reference frame map `t` = [R diag(r) | c]
@@ -565,12 +569,16 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             std::uint64_t any = 0;
             for (Eigen::Index l = 0; l < count; ++l) {
                 const std::size_t li = static_cast<std::size_t>(l);
-                if (inv_mass[begin + l] != 0) block_lists[li] = (*candidates)[bi + li] & active;
+                block_lists[li] = inv_mass[begin + l] != 0 ? (*candidates)[bi + li] & active : 0;  // pinned: none
                 r.tests += static_cast<std::uint64_t>(std::popcount(block_lists[li]));
                 any |= block_lists[li];
             }
             block_hits.fill(0);
-            if (any != 0) detect_block(x, begin, count, frames, block_lists, block_hits);
+            if (any == 0 || !detect_block(x, begin, count, frames, block_lists, block_hits)) {  // no contact
+                std::fill_n(last_collided.begin() + static_cast<std::ptrdiff_t>(bi), count, 0);
+                if (detected) std::fill_n(detected->begin() + static_cast<std::ptrdiff_t>(bi), count, 0);
+                continue;
+            }
             for (Eigen::Index l = 0; l < count; ++l) {
                 const std::size_t li = static_cast<std::size_t>(l);
                 if (block_hits[li] != 0) {
