@@ -6,9 +6,11 @@
 #pragma once
 
 // GCC 12 warns inside its own AVX-512 intrinsics, which Eigen uses for 16-float vectors
-// (-Wmaybe-uninitialized on the intrinsics' placeholder operand: GCC bug 105593, fixed in 13).
+// (-Wmaybe-uninitialized, or -Wuninitialized with the sanitizers, on the intrinsics'
+// placeholder operand: GCC bug 105593, fixed in 13).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #pragma GCC diagnostic pop
