@@ -52,7 +52,7 @@ constexpr Real shallow_share = Real(0.25);
 // and would carry the particle tens of centimetres toward the knee; the normal leaves by
 // the short side. Returns the unit-sphere image of the new place.
 // `y` = to_unit (x - c) with y_sq = |y|^2 < 1, inv_len = 1 / |y|; `along_centre` = the
-// centre-line push-out, |x - c| (1 / |y| - 1).
+// centre-line push-out (centre_line_depth).
 inline Vec3 place_shortest(const EllipsoidFrame& f, const Vec3& y, Real y_sq, Real inv_len, Real along_centre, Vec3& x,
                            Real outside) {
     if (y_sq > Real(1e-12)) {
@@ -74,10 +74,10 @@ inline Vec3 place_shortest(const EllipsoidFrame& f, const Vec3& y, Real y_sq, Re
     return place_on_surface(f, y, x, outside);
 }
 
-// How far the centre-line response moves a point inside (offset d = x - c, y_sq = |y|^2 < 1).
-inline Real centre_line_depth(const EllipsoidFrame& f, const Vec3& d, Real y_sq) {
-    const Real y_len = std::sqrt(y_sq);
-    return y_len > Real(1e-6) ? d.norm() * (1 / y_len - 1) : f.radii_m.minCoeff();
+// How far the centre-line response moves a point inside: offset d = x - c, |y| = y_len < 1,
+// inv_len = 1 / y_len.
+inline Real centre_line_depth(const EllipsoidFrame& f, const Vec3& d, Real y_len, Real inv_len) {
+    return y_len > Real(1e-6) ? d.norm() * (inv_len - 1) : f.radii_m.minCoeff();
 }
 
 // Outward unit normal at the point with unit-sphere image y (not the centre): L^T y, normalised.
@@ -424,7 +424,9 @@ inline Vec3 fallback_exit(std::span<const EllipsoidFrame> frames, std::uint64_t 
 Real penetration_depth(const EllipsoidFrame& f, const Vec3& x) {
     const Vec3 d = x - f.center;
     const Real y_sq = (f.to_unit * d).squaredNorm();
-    return y_sq >= 1 ? 0 : centre_line_depth(f, d, y_sq);
+    if (y_sq >= 1) return 0;
+    const Real y_len = std::sqrt(y_sq);
+    return centre_line_depth(f, d, y_len, 1 / y_len);
 }
 
 void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
@@ -499,7 +501,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             if (y_sq >= 1) return false;
             const Real y_len = std::sqrt(y_sq);
             const Real inv_len = 1 / y_len;
-            const Real depth = y_len > Real(1e-6) ? d.norm() * (inv_len - 1) : f.radii_m.minCoeff();  // centre_line_depth
+            const Real depth = centre_line_depth(f, d, y_len, inv_len);
             if (responses == 0 && e == first) r.max_penetration_m = std::max(r.max_penetration_m, depth);
             last_y_surface = place_shortest(f, y, y_sq, inv_len, depth, xp, outside[static_cast<std::size_t>(e)]);
             if (!whole_move) remove_approach(f, last_y_surface, xp, vp);  // else from the whole move, below
