@@ -149,13 +149,14 @@ struct WalkingScene {
 // Steps garment `g` on `body` by hand for `frames` fixed 1/60 s steps, each split into the
 // cloth's substeps (method §3.4) and run in the cloth systems' order: integrate, constrain,
 // `after_constraints(g, ctx, frame)`, then `collide(g, ctx, frame)` (by default the
-// collision system's step), so that tests can look between the systems.
+// collision system's step), so that tests can look between the systems. `hold_pose`: the
+// body keeps its pose of t = 0 instead of walking.
 template <class After, class Collide>
 void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, int frames, After&& after_constraints,
-                  Collide&& collide) {
+                  Collide&& collide, bool hold_pose = false) {
     const double dt = 1.0 / 60.0;
     for (int frame = 0; frame < frames; ++frame) {
-        body.place(registry, (frame + 1) * dt, false, dt);
+        body.place(registry, hold_pose ? 0.0 : (frame + 1) * dt, false, dt);
         const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
         FrameContext ctx;
         ctx.fixed_dt_s = dt;
