@@ -20,7 +20,8 @@
 #include "bench/probe.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
-#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth/garment_config.hpp"
+#include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace drape::bench {
@@ -66,7 +67,7 @@ Result<World> sweep_world(ClothModel model, int substeps, int iterations, Collis
     spec.threads = threads;
     auto world = build_bench_world(spec);
     if (!world) return world;
-    first_garment(*world).material.strain_iterations = iterations;
+    first_garment(*world).config.material.strain_iterations = iterations;
     return world;
 }
 
@@ -77,12 +78,12 @@ Result<Trajectory> reference_trajectory(int threads) {
     for (int frame = 0; frame <= total_frames(); ++frame) {
         const Garment& g = first_garment(*world);
         if (is_checkpoint(frame)) {
-            t.start_x.push_back(g.x);
-            t.start_v.push_back(g.v);
+            t.start_x.push_back(g.state.x);
+            t.start_v.push_back(g.state.v);
             t.end_x.emplace_back();
         }
         for (std::size_t c = 0; c < t.start_x.size(); ++c)
-            if (frame == warmup_frames + static_cast<int>(c) * checkpoint_gap_frames + horizon_frames) t.end_x[c] = g.x;
+            if (frame == warmup_frames + static_cast<int>(c) * checkpoint_gap_frames + horizon_frames) t.end_x[c] = g.state.x;
         if (auto ok = step_world(*world, frame_dt_s); !ok) return fail(ok.error().message);
     }
     return t;
@@ -91,20 +92,18 @@ Result<Trajectory> reference_trajectory(int threads) {
 Result<SweepRow> measure(SweepRow row, const Trajectory& reference, int threads) {
     auto world = sweep_world(row.model, row.substeps, row.iterations, row.collision, threads);
     if (!world) return fail(world.error().message);
-    const auto springs = structural_springs(*first_garment(*world).topology);
+    const auto springs = structural_springs(*first_garment(*world).fabric);
     const auto pinned = pinned_particles(first_garment(*world));
     std::vector<double> errors, frame_ms;
     double substeps = 0;
     int checkpoint = -1;
     int frames = 0;
     for (int frame = 0; frame < total_frames(); ++frame) {
-        Garment& g = first_garment(*world);
         if (is_checkpoint(frame)) {
             checkpoint = (frame - warmup_frames) / checkpoint_gap_frames;
-            g.x = reference.start_x[static_cast<std::size_t>(checkpoint)];
-            g.v = reference.start_v[static_cast<std::size_t>(checkpoint)];
-            std::fill(g.last_collided.begin(), g.last_collided.end(), 0);
-            g.lists_valid = false;
+            const auto c = static_cast<std::size_t>(checkpoint);
+            if (auto ok = set_garment_state(world->registry, world->garments.at(0), reference.start_x[c], reference.start_v[c]); !ok)
+                return fail(ok.error().message);
         }
         const double before = cloth_system_totals(world->scheduler).garment_ms;
         if (auto ok = step_world(*world, frame_dt_s); !ok) return fail(ok.error().message);
@@ -113,13 +112,13 @@ Result<SweepRow> measure(SweepRow row, const Trajectory& reference, int threads)
         substeps += first_garment(*world).counters.substeps;
         const Garment& after = first_garment(*world);
         if (frame >= warmup_frames) {
-            row.max_strain = std::max(row.max_strain, max_strain(after.x, springs.springs, springs.rest_m));
+            row.max_strain = std::max(row.max_strain, max_strain(after.state.x, springs.springs, springs.rest_m));
             row.max_penetration_m =
-                std::max(row.max_penetration_m, max_penetration_m(after.x, collider_worlds(world->registry, after), pinned));
+                std::max(row.max_penetration_m, max_penetration_m(after.state.x, collider_worlds(world->registry, after), pinned));
         }
         if (checkpoint >= 0 && frame + 1 == warmup_frames + checkpoint * checkpoint_gap_frames + horizon_frames) {
             const Matrix3X& ref = reference.end_x[static_cast<std::size_t>(checkpoint)];
-            errors.push_back(std::sqrt((after.x - ref).colwise().squaredNorm().mean()));
+            errors.push_back(std::sqrt((after.state.x - ref).colwise().squaredNorm().mean()));
         }
     }
     row.ms_per_frame = median(frame_ms);   // the median frame: robust to other work on the machine
@@ -146,8 +145,9 @@ Result<std::unique_ptr<Solo>> solo_cloth(Garment garment, double fixed_dt_s, int
     if (!scheduler) return fail(scheduler.error().message);
     auto solo = std::make_unique<Solo>();
     solo->scheduler = std::move(*scheduler);
-    add_cloth_systems(solo->scheduler);
-    if (substeps > 0) solo->scheduler.set_substep_rule([substeps](Registry&, double) { return substeps; });
+    ClothSolverSettings cloth;
+    cloth.fixed_substeps = substeps;
+    add_cloth_systems(solo->scheduler, cloth);
     solo->garment = solo->registry.create();
     solo->registry.emplace<Garment>(solo->garment, std::move(garment));
     return solo;
@@ -174,14 +174,14 @@ Result<OscillatorRow> oscillator(double steps_per_period) {
     p.material.strain_limit = 10;       // the largest allowed: Provot must not hold the oscillator
     auto garment = make_rectangle(p);
     if (!garment) return fail("oscillator: " + garment.error().message);
-    const std::uint32_t free = garment->topology->grid[1];   // line 0, row 1
-    const double m = 1.0 / garment->inv_mass[free];
+    const std::uint32_t free = garment->fabric->grid[1];   // line 0, row 1
+    const double m = 1.0 / garment->state.inv_mass[free];
     const double k = p.material.stretch_k_N_m;
     const double omega = std::sqrt(k / m);
     const double period = 2 * std::numbers::pi / omega;
     const double h = period / steps_per_period;
     const double amplitude = m * standard_gravity_m_s2 / k;
-    const double y_eq = garment->x(1, free) - amplitude;
+    const double y_eq = garment->state.x(1, free) - amplitude;
     auto solo = solo_cloth(std::move(*garment), h, 1);
     if (!solo) return fail("oscillator: " + solo.error().message);
     Solo& world = **solo;
@@ -190,12 +190,12 @@ Result<OscillatorRow> oscillator(double steps_per_period) {
     const int steps = static_cast<int>(std::ceil(periods * steps_per_period));
     std::vector<double> crossings;
     std::vector<double> amplitude_per_period(periods + 1, 0.0);
-    double previous = world.registry.get<Garment>(world.garment).x(1, free) - y_eq;
+    double previous = world.registry.get<Garment>(world.garment).state.x(1, free) - y_eq;
     bool stable = true;
     for (int s = 1; s <= steps; ++s) {
         if (auto ok = world.scheduler.tick(world.registry, h); !ok) return fail(ok.error().message);
         const Garment& g = world.registry.get<Garment>(world.garment);
-        const double d = g.x(1, free) - y_eq;
+        const double d = g.state.x(1, free) - y_eq;
         if (!std::isfinite(d) || std::abs(d) > 20 * amplitude || g.counters.resets > 0) {
             stable = false;
             break;
@@ -247,19 +247,19 @@ Result<ChainRow> hanging_chain(int particles) {
     if (!garment) return fail("chain: " + garment.error().message);
     const double span = 0.8;
     const auto n = static_cast<Eigen::Index>(particles);
-    const auto& grid = garment->topology->grid;
+    const auto& grid = garment->fabric->grid;
     auto at = [&](int line, Eigen::Index row) { return grid[static_cast<std::size_t>(line * n + row)]; };
     for (int line = 0; line < 2; ++line) {
         for (Eigen::Index i = 0; i < n; ++i)
-            garment->x.col(at(line, i)) = Vec3(0.05f * static_cast<Real>(line), 2, static_cast<Real>(span * i / (n - 1)));
+            garment->state.x.col(at(line, i)) = Vec3(0.05f * static_cast<Real>(line), 2, static_cast<Real>(span * i / (n - 1)));
         const std::uint32_t end = at(line, n - 1);
-        garment->inv_mass[end] = 0;
+        garment->state.inv_mass[end] = 0;
         PinBinding pin;
         pin.particle = end;
         pin.kind = PinKind::world;
-        garment->pins.push_back(pin);
+        garment->state.pins.push_back(pin);
     }
-    for (auto& b : garment->pins) b.local = garment->x.col(b.particle);
+    for (auto& b : garment->state.pins) b.local = garment->state.x.col(b.particle);
     auto solo = solo_cloth(std::move(*garment), 1.0 / 240.0, 0);
     if (!solo) return fail("chain: " + solo.error().message);
     Solo& world = **solo;
@@ -268,10 +268,10 @@ Result<ChainRow> hanging_chain(int particles) {
     const Garment& g = world.registry.get<Garment>(world.garment);
     ChainRow row{particles, 0, 0, 0, 0, 0};
     double length = 0;
-    for (Eigen::Index i = 0; i + 1 < n; ++i) length += (g.x.col(at(0, i + 1)) - g.x.col(at(0, i))).norm();
+    for (Eigen::Index i = 0; i + 1 < n; ++i) length += (g.state.x.col(at(0, i + 1)) - g.state.x.col(at(0, i))).norm();
     row.mean_strain = length / 1.0 - 1;
     double lowest = 2.0;
-    for (Eigen::Index i = 0; i < n; ++i) lowest = std::min(lowest, static_cast<double>(g.x(1, at(0, i))));
+    for (Eigen::Index i = 0; i < n; ++i) lowest = std::min(lowest, static_cast<double>(g.state.x(1, at(0, i))));
     row.sag_m = 2.0 - lowest;
     const double a = catenary_parameter(span, length);
     row.catenary_sag_m = a * (std::cosh(span / (2 * a)) - 1);
@@ -279,9 +279,9 @@ Result<ChainRow> hanging_chain(int particles) {
     row.inextensible_sag_m = a0 * (std::cosh(span / (2 * a0)) - 1);
     double sum = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
-        const double z = g.x(2, at(0, i));
+        const double z = g.state.x(2, at(0, i));
         const double y = 2.0 + a * std::cosh((z - span / 2) / a) - a * std::cosh(span / (2 * a));
-        sum += (g.x(1, at(0, i)) - y) * (g.x(1, at(0, i)) - y);
+        sum += (g.state.x(1, at(0, i)) - y) * (g.state.x(1, at(0, i)) - y);
     }
     row.rms_shape_m = std::sqrt(sum / static_cast<double>(n));
     return row;

@@ -90,18 +90,18 @@ Result<Run> alternate(const BulletTuning& tuning, int frames, bool stop_bullet_o
 
     const Garment& g0 = first_garment(*world);
     ClothSpec cloth;
-    cloth.x = g0.x;
-    const auto structural = structural_springs(*g0.topology);
+    cloth.x = g0.state.x;
+    const auto structural = structural_springs(*g0.fabric);
     cloth.springs = structural.springs;
     cloth.pinned = pinned_particles(g0);
-    cloth.mass_kg = g0.material.mass_kg / static_cast<Real>(g0.x.cols());
+    cloth.mass_kg = g0.config.material.mass_kg / static_cast<Real>(g0.state.x.cols());
     auto bullet = BulletCloth::create(cloth, collider_worlds(world->registry, g0), tuning);
     if (!bullet) return fail(bullet.error().message);
 
     Run run;
     run.drape.engine = "Drape (simplified + candidate lists)";
     run.bullet.engine = "Bullet btSoftBody";
-    run.drape.particles = run.bullet.particles = static_cast<std::size_t>(g0.x.cols());
+    run.drape.particles = run.bullet.particles = static_cast<std::size_t>(g0.state.x.cols());
     std::vector<double> drape_ms, bullet_ms;
     Matrix3X pinned_x(3, static_cast<Eigen::Index>(cloth.pinned.size()));
     for (int frame = 0; frame < settle_frames + frames; ++frame) {
@@ -111,7 +111,7 @@ Result<Run> alternate(const BulletTuning& tuning, int frames, bool stop_bullet_o
         const Garment& g = first_garment(*world);
         const auto ellipsoids = collider_worlds(world->registry, g);
         for (std::size_t k = 0; k < cloth.pinned.size(); ++k)
-            pinned_x.col(static_cast<Eigen::Index>(k)) = g.x.col(cloth.pinned[k]);
+            pinned_x.col(static_cast<Eigen::Index>(k)) = g.state.x.col(cloth.pinned[k]);
 
         Matrix3X bullet_x;
         if (!run.bullet_exploded) {
@@ -119,7 +119,7 @@ Result<Run> alternate(const BulletTuning& tuning, int frames, bool stop_bullet_o
             bullet->step(pinned_x, ellipsoids, frame_dt_s);
             const double ms = elapsed_ms(start);
             bullet_x = bullet->positions();
-            if (exploded(bullet_x, g.x)) {
+            if (exploded(bullet_x, g.state.x)) {
                 run.bullet_exploded = true;
                 run.bullet_exploded_frame = frame;
                 if (stop_bullet_on_explosion) break;
@@ -128,8 +128,8 @@ Result<Run> alternate(const BulletTuning& tuning, int frames, bool stop_bullet_o
         }
         if (frame < settle_frames) continue;
         drape_ms.push_back(after.garment_ms - before.garment_ms);
-        run.drape.max_penetration_m = std::max(run.drape.max_penetration_m, max_penetration_m(g.x, ellipsoids, cloth.pinned));
-        run.drape.max_strain = std::max(run.drape.max_strain, max_strain(g.x, structural.springs, structural.rest_m));
+        run.drape.max_penetration_m = std::max(run.drape.max_penetration_m, max_penetration_m(g.state.x, ellipsoids, cloth.pinned));
+        run.drape.max_strain = std::max(run.drape.max_strain, max_strain(g.state.x, structural.springs, structural.rest_m));
         if (!run.bullet_exploded) {
             run.bullet.max_penetration_m = std::max(run.bullet.max_penetration_m, max_penetration_m(bullet_x, ellipsoids, cloth.pinned));
             run.bullet.max_strain = std::max(run.bullet.max_strain, max_strain(bullet_x, structural.springs, structural.rest_m));

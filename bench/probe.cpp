@@ -1,6 +1,8 @@
 // Probes of a running Drape world for the benchmarks (see probe.hpp).
 #include "bench/probe.hpp"
 
+#include <algorithm>
+
 #include "components/ellipsoid_collider.hpp"
 
 namespace drape::bench {
@@ -17,14 +19,33 @@ Group simulation_group(const std::string& name) {
     return Group::other;
 }
 
+// The simulation phase's sections (the cloth systems inside the cloth step), by name; a
+// simulation system without sections counts as its own.
+std::vector<std::string> simulation_sections(const Scheduler& scheduler) {
+    const std::vector<std::string> systems = scheduler.system_names(Phase::simulation);
+    const auto is_system = [&](const std::string& name) { return std::find(systems.begin(), systems.end(), name) != systems.end(); };
+    std::vector<std::string> sections;
+    const std::vector<SystemStats> stats = scheduler.profiler().stats();
+    for (const std::string& system : systems) {
+        bool has_sections = false;
+        for (const SystemStats& st : stats)
+            if (st.parent == system) {
+                sections.push_back(st.name);
+                has_sections = true;
+            }
+        if (!has_sections && is_system(system)) sections.push_back(system);
+    }
+    return sections;
+}
+
 }  // namespace
 
 ClothSystemTime cloth_system_totals(const Scheduler& scheduler) {
     ClothSystemTime t;
     const FrameProfiler& profiler = scheduler.profiler();
-    for (const auto& name : scheduler.system_names(Phase::simulation)) {
+    for (const auto& name : scheduler.system_names(Phase::simulation)) t.garment_ms += profiler.stats(name).total_ms;
+    for (const auto& name : simulation_sections(scheduler)) {
         const double ms = profiler.stats(name).total_ms;
-        t.garment_ms += ms;
         switch (simulation_group(name)) {
             case Group::integrate: t.integrate_ms += ms; break;
             case Group::collide: t.collide_ms += ms; break;
@@ -47,7 +68,7 @@ ClothSystemTime per_frame(const ClothSystemTime& later, const ClothSystemTime& e
 std::string cloth_system_grouping(const Scheduler& scheduler) {
     std::string integrate, collide, other;
     auto append = [](std::string& list, const std::string& name) { list += (list.empty() ? "`" : " + `") + name + "`"; };
-    for (const auto& name : scheduler.system_names(Phase::simulation)) {
+    for (const auto& name : simulation_sections(scheduler)) {
         switch (simulation_group(name)) {
             case Group::integrate: append(integrate, name); break;
             case Group::collide: append(collide, name); break;
@@ -56,12 +77,17 @@ std::string cloth_system_grouping(const Scheduler& scheduler) {
     }
     std::string text = "integrate = " + (integrate.empty() ? std::string("(none)") : integrate) +
                        "; collide = " + (collide.empty() ? std::string("(none)") : collide) +
-                       "; garment total = every simulation-phase system";
+                       "; garment total = the simulation phase's systems (`" + [&] {
+                           std::string systems;
+                           for (const auto& name : scheduler.system_names(Phase::simulation))
+                               systems += (systems.empty() ? "" : "`, `") + name;
+                           return systems;
+                       }() + "`), substep rule included";
     if (!other.empty()) text += " (also " + other + ")";
     return text;
 }
 
-StructuralSprings structural_springs(const GarmentTopology& topology) {
+StructuralSprings structural_springs(const Fabric& topology) {
     StructuralSprings s;
     for (const SpringPhase* phase : {&topology.warp1, &topology.warp2, &topology.weft}) {
         for (std::size_t i = 0; i < phase->size(); ++i) {
@@ -74,14 +100,14 @@ StructuralSprings structural_springs(const GarmentTopology& topology) {
 
 std::vector<std::uint32_t> pinned_particles(const Garment& garment) {
     std::vector<std::uint32_t> pinned;
-    for (Eigen::Index i = 0; i < garment.inv_mass.size(); ++i)
-        if (garment.inv_mass[i] == 0) pinned.push_back(static_cast<std::uint32_t>(i));
+    for (Eigen::Index i = 0; i < garment.state.inv_mass.size(); ++i)
+        if (garment.state.inv_mass[i] == 0) pinned.push_back(static_cast<std::uint32_t>(i));
     return pinned;
 }
 
 std::vector<Affine3> collider_worlds(const Registry& registry, const Garment& garment) {
     std::vector<Affine3> worlds;
-    for (Entity e : garment.colliders)
+    for (Entity e : garment.body.colliders)
         if (const auto* c = registry.try_get<EllipsoidCollider>(e)) worlds.push_back(c->world);
     return worlds;
 }

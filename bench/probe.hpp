@@ -18,7 +18,7 @@ namespace drape::bench {
 /// Where the simulation phase's time goes, by the cloth system names. Integration counts
 /// the integration system and the constraint system (the paper's "integrate" includes the
 /// Provot constraints and the weft placement, method §4); collision counts the collision
-/// system; garment work is every system of the simulation phase.
+/// system; garment work is the whole simulation phase (the cloth step with its substep rule).
 struct ClothSystemTime {
     double integrate_ms = 0;
     double collide_ms = 0;
@@ -43,7 +43,7 @@ struct StructuralSprings {
     std::vector<std::array<std::uint32_t, 2>> springs;
     std::vector<Real> rest_m;
 };
-[[nodiscard]] StructuralSprings structural_springs(const GarmentTopology& topology);
+[[nodiscard]] StructuralSprings structural_springs(const Fabric& topology);
 
 /// Pinned particles (inv_mass == 0), in index order.
 [[nodiscard]] std::vector<std::uint32_t> pinned_particles(const Garment& garment);

@@ -72,7 +72,7 @@ Result<void> run_render(const BenchOptions& options) {
             if (!with_readback) return fail("render: " + with_readback.error().message);
             draw.push_back(median(*no_readback));
             readback.push_back(median(*with_readback));
-            row.particles = static_cast<std::size_t>(first_garment(*world).x.cols());
+            row.particles = static_cast<std::size_t>(first_garment(*world).state.x.cols());
             const RendererInfo& info = world->renderer->info();
             renderer_text = info.gl_renderer + " (" + info.gl_version + "), platform " + info.platform + ", MSAA " +
                             std::to_string(info.msaa_samples) + "x";

@@ -59,7 +59,7 @@ Result<Point> measure(Point p, int particles, int windows) {
         frame.push_back(t.frame_ms);
         substeps.push_back(sub / window_frames);
     }
-    p.particles = static_cast<std::size_t>(first_garment(*world).x.cols());
+    p.particles = static_cast<std::size_t>(first_garment(*world).state.x.cols());
     p.body_ms = median(body);
     p.cloth_ms = median(cloth);
     p.collide_ms = median(collide);

@@ -35,8 +35,8 @@ struct Minute {
 
 double kinetic_energy(const Garment& g) {
     double e = 0;
-    for (Eigen::Index i = 0; i < g.x.cols(); ++i)
-        if (g.inv_mass[i] > 0) e += 0.5 / g.inv_mass[i] * g.v.col(i).squaredNorm();
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i)
+        if (g.state.inv_mass[i] > 0) e += 0.5 / g.state.inv_mass[i] * g.state.v.col(i).squaredNorm();
     return e;
 }
 
@@ -73,7 +73,7 @@ Result<void> run_soak(const BenchOptions& options) {
     if (!world) return fail("soak: " + world.error().message);
     const double frame_dt_s = spec.fixed_dt_s;
     const int frames_per_minute = static_cast<int>(std::lround(60.0 / frame_dt_s));
-    const std::size_t particles = static_cast<std::size_t>(first_garment(*world).x.cols());
+    const std::size_t particles = static_cast<std::size_t>(first_garment(*world).state.x.cols());
 
     std::vector<Minute> minutes;
     std::uint64_t nonfinite_seen = first_garment(*world).counters.non_finite_values;
@@ -90,10 +90,10 @@ Result<void> run_soak(const BenchOptions& options) {
             if (auto ok = step_world(*world, frame_dt_s); !ok) return fail("soak: " + ok.error().message);
             const Garment& g = first_garment(*world);
             if (has_nonfinite(*world)) ++frames_left_nonfinite;
-            const Entity anchor = g.colliders.at(static_cast<std::size_t>(g.anchor));
+            const Entity anchor = g.body.colliders.at(static_cast<std::size_t>(g.body.anchor));
             const Vec3 hip = world->registry.get<EllipsoidCollider>(anchor).world.translation();
             row.farthest_from_hip_m =
-                std::max(row.farthest_from_hip_m, static_cast<double>((g.x.colwise() - hip).colwise().norm().maxCoeff()));
+                std::max(row.farthest_from_hip_m, static_cast<double>((g.state.x.colwise() - hip).colwise().norm().maxCoeff()));
             row.max_penetration_m = std::max(row.max_penetration_m, static_cast<double>(g.counters.max_penetration_m));
             row.max_strain = std::max(row.max_strain, static_cast<double>(g.counters.max_strain));
             const double e = kinetic_energy(g);

@@ -71,8 +71,8 @@ struct Case {
 
 double kinetic_energy(const Garment& g) {
     double e = 0;
-    for (Eigen::Index i = 0; i < g.x.cols(); ++i)
-        if (g.inv_mass[i] > 0) e += 0.5 / g.inv_mass[i] * g.v.col(i).squaredNorm();
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i)
+        if (g.state.inv_mass[i] > 0) e += 0.5 / g.state.inv_mass[i] * g.state.v.col(i).squaredNorm();
     return e;
 }
 
@@ -80,11 +80,11 @@ double kinetic_energy(const Garment& g) {
 /// the centre distance minus the largest radius).
 double farthest_from_body(const Garment& g, const std::vector<Affine3>& colliders) {
     double farthest = 0;
-    for (Eigen::Index i = 0; i < g.x.cols(); ++i) {
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i) {
         double nearest = INFINITY;
         for (const auto& c : colliders) {
             const double radius = std::max({c.linear().col(0).norm(), c.linear().col(1).norm(), c.linear().col(2).norm()});
-            nearest = std::min(nearest, (g.x.col(i) - c.translation()).norm() - radius);
+            nearest = std::min(nearest, (g.state.x.col(i) - c.translation()).norm() - radius);
         }
         if (!std::isfinite(nearest)) return INFINITY;
         farthest = std::max(farthest, nearest);
@@ -103,24 +103,20 @@ Result<void> run_case(World& world, Case& c) {
     player.playing = true;
     if (auto ok = set_time_scale(world, c.motion == Motion::time_scale ? 10.0 : 1.0); !ok) return fail(ok.error().message);
     Garment& g0 = first_garment(world);
-    g0.material.stretch_k_N_m = static_cast<Real>(c.stiffness);
-    if (c.auto_substeps)
-        world.scheduler.set_substep_rule([](Registry& reg, double dt) { return cloth_substeps(reg, dt, {}); });
-    else
-        world.scheduler.set_substep_rule([](Registry&, double) { return 1; });
+    g0.config.material.stretch_k_N_m = static_cast<Real>(c.stiffness);
     reset_garments(world);
     {
         const Garment& g = first_garment(world);
         double m = 0;
-        for (Eigen::Index i = 0; i < g.inv_mass.size(); ++i)
-            if (g.inv_mass[i] > 0) {
-                m = 1.0 / g.inv_mass[i];
+        for (Eigen::Index i = 0; i < g.state.inv_mass.size(); ++i)
+            if (g.state.inv_mass[i] > 0) {
+                m = 1.0 / g.state.inv_mass[i];
                 break;
             }
         c.bound_simple_s = 2 * std::sqrt(m / c.stiffness);
-        c.bound_cloth_s = stable_step_s(*g.topology, g.material, g.inv_mass, g.model);
+        c.bound_cloth_s = stable_step_s(*g.fabric, g.config.material, g.state.inv_mass, g.config.model);
     }
-    const auto springs = structural_springs(*first_garment(world).topology);
+    const auto springs = structural_springs(*first_garment(world).fabric);
     const std::uint64_t nonfinite_before = first_garment(world).counters.non_finite_values;
 
     const int frames = std::max(16, static_cast<int>(std::lround(0.75 / c.frame_dt_s)));
@@ -146,12 +142,12 @@ Result<void> run_case(World& world, Case& c) {
         if (auto ok = step_world(world, c.frame_dt_s); !ok) return fail(ok.error().message);
         const Garment& g = first_garment(world);
         substeps += g.counters.substeps;
-        if (g.counters.non_finite_values > nonfinite_before || !g.x.allFinite() || !g.v.allFinite()) {
+        if (g.counters.non_finite_values > nonfinite_before || !g.state.x.allFinite() || !g.state.v.allFinite()) {
             c.stable = false;
             c.reason = "non-finite values (frame " + std::to_string(f) + ")";
             break;
         }
-        const double strain = max_strain(g.x, springs.springs, springs.rest_m);
+        const double strain = max_strain(g.state.x, springs.springs, springs.rest_m);
         c.max_strain = std::max(c.max_strain, strain);
         const double energy = kinetic_energy(g);
         if (f >= frames / 3 && f < 2 * frames / 3) middle_peak = std::max(middle_peak, energy);
@@ -186,14 +182,15 @@ Result<void> run_stability(const BenchOptions& options) {
     std::vector<Case> cases;
     for (GarmentType garment : {GarmentType::skirt, GarmentType::dress}) {
         for (double dt : steps_s) {
-            WorldSpec spec;
-            spec.garment = garment;
-            spec.fixed_dt_s = dt;
-            spec.threads = options.threads;
-            auto world = build_bench_world(spec);
-            if (!world) return fail("stability: " + world.error().message);
             std::fprintf(stderr, "drape bench stability: %s, step %s s\n", garment_type_name(garment), step_label(dt));
-            for (bool automatic : {true, false})
+            for (bool automatic : {true, false}) {
+                WorldSpec spec;
+                spec.garment = garment;
+                spec.fixed_dt_s = dt;
+                spec.threads = options.threads;
+                spec.substeps = automatic ? 0 : 1;
+                auto world = build_bench_world(spec);
+                if (!world) return fail("stability: " + world.error().message);
                 for (double k : stiffness_set(garment))
                     for (Motion motion : motions) {
                         Case c;
@@ -207,6 +204,7 @@ Result<void> run_stability(const BenchOptions& options) {
                         if (auto ok = run_case(*world, c); !ok) return fail("stability: " + c.name + ": " + ok.error().message);
                         cases.push_back(c);
                     }
+            }
         }
     }
 

@@ -92,8 +92,8 @@ Result<void> run_table1(const BenchOptions& options) {
         if (run == 0) {
             World& w = worlds[1];
             const Garment& g = first_garment(w);
-            particles = static_cast<std::size_t>(g.x.cols());
-            garment_colliders = g.colliders.size();
+            particles = static_cast<std::size_t>(g.state.x.cols());
+            garment_colliders = g.body.colliders.size();
             ellipsoids = all_collider_worlds(w.registry).size() / std::max<std::size_t>(1, w.characters.size());
             if (const auto* s = w.registry.try_get<Skeleton>(w.characters.at(0)); s && s->asset) bones = s->asset->size();
             grouping = cloth_system_grouping(w.scheduler);

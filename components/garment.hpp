@@ -1,11 +1,20 @@
-// A garment: a cooked, shared topology (the "fabric") and light per-instance particle
-// state in structure-of-arrays form (method §3, §4, §5).
+// A garment, split the way cloth engines split it (Jolt's SoftBodySharedSettings / creation
+// settings / motion properties, NvCloth's Fabric / Cloth):
+//   Fabric          cooked topology and rest lengths, immutable, shared by every instance;
+//   GarmentConfig   per-instance configuration: model, collision mode, material, colour;
+//   GarmentBody     what the garment is worn by: the character, its colliders, the anchor;
+//   GarmentState    particle positions, velocities, inverse masses and pins;
+//   GarmentCounters what the cloth systems did (read by statistics).
+// Solver caches and scratch (candidate lists, collider frames, stability bounds) are not
+// here: they belong to the cloth module (systems/cloth/garment_solver.hpp). Change the model
+// or the material through systems/cloth/garment_config.hpp, which invalidates what depends
+// on them.
 //
-// Conventions
+// Conventions (method §3.2)
 // - The garment is an m x n particle grid: `warp_lines` lines of `particles_per_line`
 //   particles; a line runs along the warp (down from the fitting zone), a row along the
-//   weft. Every `weft_stride`-th warp line is layer 1 (integrated, method §3.2); the lines
-//   between are layer 2 (placed from their layer-1 neighbours, method §4.2).
+//   weft. Every `weft_stride`-th warp line is layer 1 (integrated); the lines between are
+//   layer 2 (placed from their layer-1 neighbours, method §4.2).
 // - Particles are stored layer 1 first: columns [0, layer1_count) of `x` are the layer-1
 //   particles, so the simplified model integrates one contiguous block.
 // - Springs are flat parallel index arrays (`SpringPhase`). Warp springs are listed line by
@@ -13,15 +22,11 @@
 // - `inv_mass` is the same in both models (total mass / particle count, 0 = pinned). In the
 //   simplified model a layer-1 particle carries the mass, drag and spring stiffness of the
 //   weft particles it stands for (`layer1_mass_scale`).
-//
-// The cloth systems own the meaning of most fields; the render system reads only
-// `x`, `topology->triangles` and `color`.
+// The render system reads only `state.x`, `fabric->triangles` and `config.color`.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <memory>
-#include <string>
 #include <vector>
 
 #include "engine/core/math.hpp"
@@ -51,8 +56,8 @@ struct SpringPhase {
     void add(std::uint32_t i, std::uint32_t j, Real rest) { a.push_back(i); b.push_back(j); rest_m.push_back(rest); }
 };
 
-/// Immutable garment data shared by every instance.
-struct GarmentTopology {
+/// The cooked garment: topology and rest lengths, immutable, shared by every instance.
+struct Fabric {
     std::uint32_t warp_lines = 0;           ///< n: lines along the warp.
     std::uint32_t particles_per_line = 0;   ///< m: particles on each warp line.
     std::uint32_t weft_stride = 1;          ///< Every weft_stride-th line is layer 1.
@@ -88,24 +93,6 @@ struct GarmentTopology {
     [[nodiscard]] std::size_t particle_count() const noexcept { return layer.size(); }
 };
 
-/// What a pin follows.
-enum class PinKind : std::uint8_t {
-    world,     ///< Fixed in world space at `local` (flat test cloth).
-    collider,  ///< Rigidly bound to an ellipsoid: `local` in its unit-sphere frame.
-    skinned,   ///< Skinned like a skin vertex: `local` in bind model space, `bones`/`weights`
-               ///< blended with Skeleton::skinning, then the character's Transform.
-};
-
-/// What one particle is pinned to (method §3.5). Only particles with inv_mass == 0 have one.
-struct PinBinding {
-    std::uint32_t particle = 0;
-    PinKind kind = PinKind::world;
-    std::int32_t collider = -1;             ///< PinKind::collider: index into Garment::colliders.
-    Vec3 local = Vec3::Zero();              ///< See PinKind.
-    Vec4i bones = Vec4i::Zero();            ///< Skinned pin: up to 4 bone indices.
-    Vec4 weights = Vec4::Zero();            ///< Skinned pin: weights, sum 1 (unused: weight 0).
-};
-
 /// Material and solver settings of one garment instance.
 struct ClothMaterial {
     Real mass_kg = Real(0.35);              ///< Whole garment.
@@ -119,6 +106,50 @@ struct ClothMaterial {
     friend bool operator==(const ClothMaterial&, const ClothMaterial&) = default;
 };
 
+/// Per-instance configuration. Read freely; change `model` and `material` through
+/// systems/cloth/garment_config.hpp so that the solver's caches follow.
+struct GarmentConfig {
+    ClothModel model = ClothModel::simplified;
+    CollisionMode collision = CollisionMode::candidate_lists;
+    ClothMaterial material;
+    Vec3 color = Vec3(0.75f, 0.12f, 0.18f);  ///< Linear RGB.
+    friend bool operator==(const GarmentConfig&, const GarmentConfig&) = default;
+};
+
+/// What a pin follows.
+enum class PinKind : std::uint8_t {
+    world,     ///< Fixed in world space at `local` (flat test cloth).
+    collider,  ///< Rigidly bound to an ellipsoid: `local` in its unit-sphere frame.
+    skinned,   ///< Skinned like a skin vertex: `local` in bind model space, `bones`/`weights`
+               ///< blended with Skeleton::skinning, then the character's Transform.
+};
+
+/// What one particle is pinned to (method §3.5). Only particles with inv_mass == 0 have one.
+struct PinBinding {
+    std::uint32_t particle = 0;
+    PinKind kind = PinKind::world;
+    std::int32_t collider = -1;             ///< PinKind::collider: index into GarmentBody::colliders.
+    Vec3 local = Vec3::Zero();              ///< See PinKind.
+    Vec4i bones = Vec4i::Zero();            ///< Skinned pin: up to 4 bone indices.
+    Vec4 weights = Vec4::Zero();            ///< Skinned pin: weights, sum 1 (unused: weight 0).
+};
+
+/// What the garment is worn by.
+struct GarmentBody {
+    Entity character;                        ///< The character wearing it.
+    std::vector<Entity> colliders;           ///< EllipsoidCollider entities the garment collides with (<= 64).
+    std::int32_t anchor = -1;                ///< Collider whose rigid motion is "the body" of method §3.3 (-1: none).
+    Matrix3X rest_local;                     ///< Rest shape in the anchor's frame (rotation + centre), for resets.
+};
+
+/// Particle state in structure-of-arrays form.
+struct GarmentState {
+    Matrix3X x;                   ///< Particle positions, world, m.
+    Matrix3X v;                   ///< Particle velocities, m/s.
+    VectorX inv_mass;             ///< 1/kg; 0 = pinned.
+    std::vector<PinBinding> pins; ///< One per pinned particle.
+};
+
 /// Per-garment counters. `frame_*` restart each fixed step; the rest accumulate.
 struct GarmentCounters {
     std::uint64_t frame_collision_tests = 0;  ///< Unit-sphere tests this fixed step (all substeps).
@@ -126,7 +157,7 @@ struct GarmentCounters {
     std::uint64_t frame_list_rebuild_tests = 0; ///< Candidate-list (broad phase) tests this step.
     Real max_strain = 0;                      ///< Largest warp/weft spring length / rest - 1 after constraints, last substep.
     Real max_penetration_m = 0;               ///< Deepest penetration found this step (before response).
-    int substeps = 1;                         ///< Substeps of the last fixed step (all garments share it).
+    int substeps = 1;                         ///< Substeps of the last fixed step.
     int substeps_stability = 1;               ///< This garment's need from the stability bound (method §3.4).
     int substeps_motion = 1;                  ///< This garment's need from collider surface travel.
     std::uint64_t unresolved = 0;             ///< Particles left inside overlapping ellipsoids after the re-test cap.
@@ -139,60 +170,12 @@ struct GarmentCounters {
     std::uint64_t steps = 0;                  ///< Fixed steps simulated.
 };
 
-/// One collider as the cloth sees it during a substep (unit sphere <-> world).
-struct EllipsoidFrame {
-    Mat3 to_unit = Mat3::Identity();   ///< diag(1/r) R^T.
-    Mat3 rotation = Mat3::Identity();  ///< R.
-    Vec3 center = Vec3::Zero();        ///< c, m.
-    Vec3 radii_m = Vec3::Ones();
-    Vec3 velocity_m_s = Vec3::Zero();
-    Vec3 acceleration_m_s2 = Vec3::Zero();
-    Vec3 angular_velocity_rad_s = Vec3::Zero();
-    bool active = false;               ///< False when the collider entity is gone: never tested.
-};
-
 struct Garment {
-    std::shared_ptr<const GarmentTopology> topology;
-    Entity body;                             ///< The character the garment is worn by.
-    ClothModel model = ClothModel::simplified;
-    CollisionMode collision = CollisionMode::candidate_lists;
-    Vec3 color = Vec3(0.75f, 0.12f, 0.18f);  ///< Linear RGB.
-    ClothMaterial material;
-
-    Matrix3X x;         ///< Particle positions, world, m.
-    Matrix3X v;         ///< Particle velocities, m/s.
-    VectorX inv_mass;   ///< 1/kg; 0 = pinned.
-
-    // Body.
-    std::vector<Entity> colliders;           ///< EllipsoidCollider entities the garment collides with (<= 64).
-    std::int32_t anchor = -1;                ///< Collider whose rigid motion is "the body" of method §3.3 (-1: none).
-    std::vector<PinBinding> pins;            ///< One per pinned particle.
-    Matrix3X rest_local;                     ///< Rest shape in the anchor's frame (rotation + centre), for reset_garment().
-
-    // Collision state (method §5).
-    std::vector<std::uint64_t> candidates;   ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
-    std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep.
-    bool lists_valid = false;                ///< False: rebuild the candidate lists before the next test.
-    Matrix3XRows list_anchor_x;              ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
-    std::vector<Affine3> list_anchor_frames; ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed (zero: none).
-    Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> list_clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
-    VectorX list_slack_m;                    ///< Per particle: how far it may still move before its list could miss a collider, after the last list update, m.
-    Matrix3XRows list_scratch;               ///< Anchor-frame positions, reused by the list bookkeeping every substep.
-
+    std::shared_ptr<const Fabric> fabric;   ///< Shared, immutable.
+    GarmentConfig config;
+    GarmentBody body;
+    GarmentState state;
     GarmentCounters counters;
-
-    // Scratch and caches the systems keep between substeps (no allocation per step).
-    Matrix3X force;                          ///< Spring forces, N.
-    Matrix3X x_start;                        ///< Positions at the start of the substep (contact velocities).
-    Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
-    Matrix3X normals;                        ///< Layer-1 normals for weft placement.
-    Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.
-    std::vector<std::uint8_t> movable;       ///< Per particle: 1 unless pinned.
-    std::vector<std::uint8_t> movable_weft;  ///< Per particle: 1 for free layer-2 particles.
-    std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep.
-    std::array<Real, 2> stable_step_s{0, 0}; ///< Stability bound per model (method §3.4), for `cached_material`.
-    ClothMaterial cached_material;
-    bool stability_valid = false;
 };
 
 }  // namespace drape

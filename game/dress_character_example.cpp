@@ -17,7 +17,7 @@
 #include "game/scene.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
-#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace {
@@ -31,11 +31,11 @@ int fail_with(const std::string& message) {
 // method §5; pinned particles follow the skin and may sit inside).
 int particles_inside(drape::Registry& registry, const drape::Garment& garment) {
     int inside = 0;
-    for (Eigen::Index i = 0; i < garment.x.cols(); ++i) {
-        if (garment.inv_mass[i] == 0) continue;
+    for (Eigen::Index i = 0; i < garment.state.x.cols(); ++i) {
+        if (garment.state.inv_mass[i] == 0) continue;
         bool in = false;
         registry.view<drape::EllipsoidCollider>().each([&](drape::Entity, drape::EllipsoidCollider& c) {
-            if (c.character == garment.body && (c.world.inverse() * garment.x.col(i)).norm() < 0.99f) in = true;
+            if (c.character == garment.body.character && (c.world.inverse() * garment.state.x.col(i)).norm() < 0.99f) in = true;
         });
         inside += in ? 1 : 0;
     }
@@ -80,10 +80,10 @@ int main(int argc, char** argv) {
 
     const drape::Garment& g = registry.get<drape::Garment>(*garment);
     std::fputs(scheduler.profiler().table().c_str(), stdout);
-    const bool finite = g.x.allFinite() && g.v.allFinite();
+    const bool finite = g.state.x.allFinite() && g.state.v.allFinite();
     const int inside = particles_inside(registry, g);
     std::printf("%s: %lld particles, lowest at %.3f m, max strain %.3f, %d inside an ellipsoid, %s\n", file.c_str(),
-                static_cast<long long>(g.x.cols()), finite ? double(g.x.row(1).minCoeff()) : 0.0, double(g.counters.max_strain),
+                static_cast<long long>(g.state.x.cols()), finite ? double(g.state.x.row(1).minCoeff()) : 0.0, double(g.counters.max_strain),
                 inside, finite ? "all finite" : "NON-FINITE VALUES");
     return finite && inside == 0 ? 0 : 1;
 }

@@ -17,7 +17,8 @@
 #include "engine/assets/character_import.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
-#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth/garment_config.hpp"
+#include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
@@ -203,7 +204,7 @@ System make_teleport_guard(double threshold_m, std::shared_ptr<TeleportLog> log)
             });
             std::vector<Entity> worn;
             registry.view<Garment>().each([&](Entity g, Garment& garment) {
-                if (garment.body == character) worn.push_back(g);
+                if (garment.body.character == character) worn.push_back(g);
             });
             for (Entity g : worn) {
                 reset_garment(registry, g);
@@ -265,11 +266,9 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
     // Systems: characters, teleport guard, cloth (+ fixed substeps), render.
     add_character_systems(world.scheduler);
     world.scheduler.add(make_teleport_guard(scene.solver.teleport_threshold_m, world.teleports));
-    add_cloth_systems(world.scheduler);
-    if (scene.solver.substeps > 0) {
-        const int n = scene.solver.substeps;
-        world.scheduler.set_substep_rule([n](Registry&, double) { return n; });
-    }
+    ClothSolverSettings cloth;
+    cloth.fixed_substeps = scene.solver.substeps;
+    add_cloth_systems(world.scheduler, cloth);
     // The garment builders fit around placed colliders (overrides included): one skinning
     // pass (skinning, colliders) places them before the first step.
     world.scheduler.run_phase(world.registry, Phase::skinning, FrameContext{.fixed_dt_s = scene.solver.fixed_dt_s});
@@ -339,10 +338,7 @@ void reset_garments(World& world) {
 
 void set_garment_model(World& world, ClothModel model) {
     for (std::size_t i = 0; i < world.garments.size(); ++i) {
-        if (Garment* g = world.registry.try_get<Garment>(world.garments[i])) {
-            g->model = model;
-            g->stability_valid = false;
-        }
+        set_garment_model(world.registry, world.garments[i], model);
         if (i < world.scene.garments.size()) world.scene.garments[i].model = model;
     }
 }
@@ -359,7 +355,7 @@ RunStats run_stats(const World& world) {
 
 bool has_nonfinite(const World& world) {
     for (Entity e : world.garments)
-        if (const Garment* g = world.registry.try_get<Garment>(e); g && (!g->x.allFinite() || !g->v.allFinite())) return true;
+        if (const Garment* g = world.registry.try_get<Garment>(e); g && (!g->state.x.allFinite() || !g->state.v.allFinite())) return true;
     for (Entity e : world.characters)
         if (const SkinnedMesh* m = world.registry.try_get<SkinnedMesh>(e); m && !m->positions.allFinite()) return true;
     return false;

@@ -24,8 +24,8 @@ void GarmentWatch::sample(const Registry& registry) {
         const GarmentCounters& c = g->counters;
         if (std::isfinite(c.max_strain)) t.max_strain = std::max(t.max_strain, double(c.max_strain));
         if (std::isfinite(c.max_penetration_m)) t.max_penetration_m = std::max(t.max_penetration_m, double(c.max_penetration_m));
-        for (Eigen::Index i = 0; i < g->x.cols(); ++i)
-            if (!g->x.col(i).allFinite() || (i < g->v.cols() && !g->v.col(i).allFinite())) ++t.nonfinite_seen;
+        for (Eigen::Index i = 0; i < g->state.x.cols(); ++i)
+            if (!g->state.x.col(i).allFinite() || (i < g->state.v.cols() && !g->state.v.col(i).allFinite())) ++t.nonfinite_seen;
     }
 }
 
@@ -37,7 +37,7 @@ std::vector<GarmentStats> GarmentWatch::result(const Registry& registry) const {
         s.max_penetration_m = t.max_penetration_m;
         s.nonfinite = t.nonfinite_seen;
         if (const Garment* g = registry.try_get<Garment>(t.entity)) {
-            s.particles = static_cast<std::uint64_t>(g->x.cols());
+            s.particles = static_cast<std::uint64_t>(g->state.x.cols());
             s.nonfinite += g->counters.non_finite_values;
             if (m_frames > 0)
                 s.collision_tests_per_frame = double(g->counters.collision_tests - t.tests_at_start) / double(m_frames);

@@ -1,23 +1,10 @@
+// Cloth collision system; see cloth_collision_system.hpp.
 #include "systems/cloth_collision_system.hpp"
-
-#include <memory>
-
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/cloth/garment_step.hpp"
-#include "systems/cloth/parallel.hpp"
 
 namespace drape {
 
-System make_cloth_collision_system() {
-    auto batch = std::make_shared<GarmentBatch>();
-    return System{"cloth_collision", Phase::simulation, {}, components<Garment>(),
-                  components<EllipsoidCollider, Skeleton, Transform>(),
-                  [batch](Registry& registry, const FrameContext& context) {
-                      for_each_garment(registry, *batch, [&](Garment& g) { collide_garment_step(registry, g, context); });
-                  }};
+void run_cloth_collision(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep) {
+    batch.for_each([&](Garment& g, GarmentSolver& s) { collide_garment_step(registry, g, s, substep); });
 }
 
 }  // namespace drape

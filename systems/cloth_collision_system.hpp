@@ -1,13 +1,16 @@
-// Cloth collision (method §5): candidate lists, last-collided first, unit-sphere test,
-// centre-line response; then the non-finite check (report, count, reset). Third of the
-// three cloth systems in each substep.
+// Cloth collision system (method §5): every garment against the ellipsoids of its body at
+// the end of the substep, with candidate lists and temporal coherence, then the
+// non-finite check. Last of the three cloth systems in every substep, timed as
+// "cloth_collision".
 #pragma once
 
-#include "engine/core/scheduler.hpp"
+#include "engine/core/registry.hpp"
+#include "systems/cloth/garment_batch.hpp"
+#include "systems/cloth/garment_step.hpp"
 
 namespace drape {
 
-/// Phase simulation; writes Garment; reads EllipsoidCollider, Skeleton, Transform when present.
-[[nodiscard]] System make_cloth_collision_system();
+/// One substep of every garment of `batch`, in parallel over garments.
+void run_cloth_collision(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep);
 
 }  // namespace drape

@@ -1,13 +1,16 @@
-// Cloth constraints (method §4): Provot strain limiting on the warp (§4.1); for the
-// simplified model layer-2 placement in its planes and Provot on the weft (§4.2). Second of
-// the three cloth systems in each substep.
+// Cloth constraint system (method §4): Provot's strain limit on the warp (§4.1); in the
+// simplified model the weft (layer 2) placed from layer 1 (§4.2); in the classic model
+// Provot on warp and weft. Second of the three cloth systems in every substep, timed as
+// "cloth_constraint".
 #pragma once
 
-#include "engine/core/scheduler.hpp"
+#include "systems/cloth/garment_batch.hpp"
+#include "systems/cloth/garment_step.hpp"
 
 namespace drape {
 
-/// Phase simulation; writes Garment; reads EllipsoidCollider, Skeleton, Transform when present.
-[[nodiscard]] System make_cloth_constraint_system();
+/// One substep of every garment of `batch`, in parallel over garments. After the last
+/// substep's constraints it records each garment's largest strain.
+void run_cloth_constraint(const GarmentBatch& batch, const ClothSubstep& substep);
 
 }  // namespace drape

@@ -1,13 +1,17 @@
-// Cloth integration (method §3.3-§3.4): the body-driven force of paper eq. 2 and symplectic
-// Euler on the integrated particles (simplified model: layer 1; classic: all), then the
-// fitting-zone pins (§3.5). First of the three cloth systems in each substep.
+// Cloth integration system (method §3.3-§3.5): the body-driven force of paper eq. 2 and
+// symplectic Euler on the integrated particles (simplified model: layer 1; classic: all),
+// then the fitting-zone pins. First of the three cloth systems in every substep; the cloth
+// step (cloth_systems.hpp) runs it and times it as "cloth_integration".
 #pragma once
 
-#include "engine/core/scheduler.hpp"
+#include "engine/core/registry.hpp"
+#include "systems/cloth/garment_batch.hpp"
+#include "systems/cloth/garment_step.hpp"
 
 namespace drape {
 
-/// Phase simulation; writes Garment; reads EllipsoidCollider, Skeleton, Transform when present.
-[[nodiscard]] System make_cloth_integration_system();
+/// One substep of every garment of `batch`, in parallel over garments. At the first
+/// substep it also starts each garment's step (counters, pin targets).
+void run_cloth_integration(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep);
 
 }  // namespace drape

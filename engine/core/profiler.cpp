@@ -30,12 +30,19 @@ std::string json_escape(std::string_view s) {
 
 FrameProfiler::FrameProfiler(std::size_t ring_capacity) : m_capacity(std::max<std::size_t>(ring_capacity, 16)) {}
 
-std::uint32_t FrameProfiler::add_slot(std::string name) {
+std::uint32_t FrameProfiler::add_slot(std::string name, std::uint32_t parent) {
     Slot slot;
     slot.name = std::move(name);
+    slot.parent = parent < m_slots.size() ? parent : no_parent;
     slot.recent_ms.reserve(m_capacity);
     m_slots.push_back(std::move(slot));
     return static_cast<std::uint32_t>(m_slots.size() - 1);
+}
+
+void FrameProfiler::record_skip(std::uint32_t slot) noexcept {
+    ++m_slots[slot].skips;
+    for (Slot& s : m_slots)
+        if (s.parent == slot) ++s.skips;
 }
 
 void FrameProfiler::begin_frame() noexcept {
@@ -81,6 +88,7 @@ std::vector<SystemStats> FrameProfiler::stats() const {
     for (const Slot& s : m_slots) {
         SystemStats st;
         st.name = s.name;
+        if (s.parent != no_parent) st.parent = m_slots[s.parent].name;
         st.runs = s.runs;
         st.skips = s.skips;
         st.total_ms = s.total_ms;
@@ -110,7 +118,8 @@ std::string FrameProfiler::table() const {
                   "mean ms", "p50 ms", "p95 ms", "max ms", "share");
     out += line;
     for (const SystemStats& s : stats()) {
-        std::snprintf(line, sizeof line, "%-28s %8llu %8llu %9.4f %9.4f %9.4f %9.4f %6.1f%%\n", s.name.c_str(),
+        const std::string name = s.parent.empty() ? s.name : "  " + s.name;  // a section, under its system
+        std::snprintf(line, sizeof line, "%-28s %8llu %8llu %9.4f %9.4f %9.4f %9.4f %6.1f%%\n", name.c_str(),
                       static_cast<unsigned long long>(s.runs), static_cast<unsigned long long>(s.skips), s.mean_ms,
                       s.p50_ms, s.p95_ms, s.max_ms, 100.0 * s.share);
         out += line;

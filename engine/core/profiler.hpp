@@ -18,9 +18,10 @@
 
 namespace drape {
 
-/// Summary of one system over a run.
+/// Summary of one system (or timed section of a system) over a run.
 struct SystemStats {
     std::string name;
+    std::string parent;  ///< The slot this one is a section of (empty: a system of its own).
     std::uint64_t runs = 0;
     std::uint64_t skips = 0;
     double mean_ms = 0;
@@ -38,8 +39,12 @@ public:
     /// `ring_capacity`: durations kept per system for percentiles, and trace events kept.
     explicit FrameProfiler(std::size_t ring_capacity = 1 << 14);
 
-    /// Registers a named slot (a system, or any timed section) and returns its index.
-    std::uint32_t add_slot(std::string name);
+    static constexpr std::uint32_t no_parent = 0xffffffffu;
+
+    /// Registers a named slot (a system, or any timed section) and returns its index. A
+    /// section of another slot names it as `parent`: it is listed under it, and a skip of
+    /// the parent counts for it too.
+    std::uint32_t add_slot(std::string name, std::uint32_t parent = no_parent);
 
     [[nodiscard]] bool timing() const noexcept { return m_timing; }
     void set_timing(bool on) noexcept { m_timing = on; }
@@ -48,7 +53,7 @@ public:
     void end_frame() noexcept;
     void record_run(std::uint32_t slot, Clock::time_point start, Clock::time_point end) noexcept;
     void record_untimed_run(std::uint32_t slot) noexcept { ++m_slots[slot].runs; }
-    void record_skip(std::uint32_t slot) noexcept { ++m_slots[slot].skips; }
+    void record_skip(std::uint32_t slot) noexcept;
 
     [[nodiscard]] std::uint64_t frames() const noexcept { return m_frames; }
     /// Mean wall time of a whole frame (all phases, scheduler overhead included), ms.
@@ -69,6 +74,7 @@ public:
 private:
     struct Slot {
         std::string name;
+        std::uint32_t parent = no_parent;
         std::uint64_t runs = 0, skips = 0;
         double total_ms = 0, max_ms = 0;
         std::vector<float> recent_ms;  ///< Ring buffer.

@@ -56,13 +56,15 @@ bool Scheduler::present(const Registry& registry, const System& system) {
 }
 
 void Scheduler::run_phase(Registry& registry, Phase phase, const FrameContext& context) {
+    FrameContext ctx = context;
+    ctx.profiler = &m_profiler;
     for (Entry& entry : m_phases[static_cast<std::size_t>(phase)]) {
         if (!present(registry, entry.system)) {
             m_profiler.record_skip(entry.slot);
             continue;
         }
         ProfileScope scope(m_profiler, entry.slot);
-        entry.system.run(registry, context);
+        entry.system.run(registry, ctx);
     }
 }
 
@@ -98,25 +100,13 @@ Result<FrameReport> Scheduler::tick(Registry& registry, double frame_dt_s) {
     for (int step = 0; step < steps; ++step) {
         context.step = step;
         context.time_s = m_time_s;
-        context.substep = 0;
-        context.substeps = 1;
-        context.h_s = step_s;
         run_phase(registry, Phase::animation, context);
         run_phase(registry, Phase::skinning, context);
-
-        const int substeps = m_substep_rule ? std::max(1, m_substep_rule(registry, step_s)) : 1;
-        context.substeps = substeps;
-        context.h_s = step_s / substeps;
-        for (int sub = 0; sub < substeps; ++sub) {
-            context.substep = sub;
-            run_phase(registry, Phase::simulation, context);
-        }
+        run_phase(registry, Phase::simulation, context);
         m_time_s += step_s;
     }
 
     context.time_s = m_time_s;
-    context.substep = 0;
-    context.substeps = 1;
     run_phase(registry, Phase::render, context);
     m_profiler.end_frame();
     ++m_frame;

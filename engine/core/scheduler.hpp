@@ -4,7 +4,7 @@
 //   input                       once per frame
 //   repeat for each fixed step taken from the accumulator:
 //     animation, skinning       once per step (colliders follow their bones in skinning)
-//     simulation                `substeps` rounds per step, h = fixed_dt / substeps
+//     simulation                once per step (a solver that substeps owns its loop)
 //   render                      once per frame
 // Within a phase, systems run in the order they were added.
 //
@@ -42,9 +42,7 @@ struct FrameContext {
     double time_s = 0;            ///< Simulated time at the start of this step.
     int step = 0;                 ///< Index of the fixed step within this frame.
     int steps = 0;                ///< Fixed steps taken this frame (known once stepping starts).
-    int substep = 0;              ///< Simulation phase: index of the substep.
-    int substeps = 1;             ///< Simulation phase: substeps in this step.
-    double h_s = 0;               ///< Simulation phase: substep length, fixed_dt_s / substeps.
+    FrameProfiler* profiler = nullptr;  ///< The scheduler's, for systems that time sections of their own.
 };
 
 using SystemFn = std::function<void(Registry&, const FrameContext&)>;
@@ -87,10 +85,6 @@ public:
     /// Adds a system; returns its profiler slot.
     std::uint32_t add(System system);
 
-    /// Decides the number of simulation substeps for each fixed step (default: 1).
-    /// The cloth module installs its stability rule here (method §3.4).
-    void set_substep_rule(std::function<int(Registry&, double fixed_dt_s)> rule) { m_substep_rule = std::move(rule); }
-
     /// Runs one frame. Errors only on a bad frame time; then nothing runs.
     Result<FrameReport> tick(Registry& registry, double frame_dt_s);
 
@@ -116,7 +110,6 @@ private:
 
     SchedulerSettings m_settings;
     std::array<std::vector<Entry>, phase_count> m_phases;
-    std::function<int(Registry&, double)> m_substep_rule;
     FrameProfiler m_profiler;
     double m_accumulator_s = 0;
     double m_time_s = 0;

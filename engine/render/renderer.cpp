@@ -169,7 +169,7 @@ struct Renderer::Impl {
     };
     struct GarmentEntry {
         MeshBuffers buffers;
-        const GarmentTopology* topology = nullptr;
+        const Fabric* topology = nullptr;
         Matrix3X normals;
         Vec3 color = Vec3::Zero();
         std::uint64_t seen = 0;
@@ -370,11 +370,11 @@ void Renderer::Impl::draw(Registry& registry) {
 
     // --- Gather and upload: garments -----------------------------------------------------
     registry.view<Garment>().each([&](Entity e, Garment& garment) {
-        if (!garment.topology || garment.x.cols() == 0 || garment.topology->triangles.empty()) return;
-        const GarmentTopology& topology = *garment.topology;
+        if (!garment.fabric || garment.state.x.cols() == 0 || garment.fabric->triangles.empty()) return;
+        const Fabric& topology = *garment.fabric;
         GarmentEntry& entry = garments[key_of(e)];
         entry.seen = frame;
-        if (entry.topology != &topology || entry.buffers.vertex_count != garment.x.cols()) {
+        if (entry.topology != &topology || entry.buffers.vertex_count != garment.state.x.cols()) {
             entry.buffers.destroy();
             entry.topology = nullptr;
             if (topology.triangles.size() % 3 != 0) {
@@ -382,18 +382,18 @@ void Renderer::Impl::draw(Registry& registry) {
                      std::to_string(topology.triangles.size()) + " is not a multiple of 3");
                 return;
             }
-            if (auto bad = first_bad_index(topology.triangles, std::size_t(garment.x.cols())); bad >= 0) {
+            if (auto bad = first_bad_index(topology.triangles, std::size_t(garment.state.x.cols())); bad >= 0) {
                 note("garment of entity " + std::to_string(e.index) + ": triangles[" + std::to_string(bad) + "] = " +
                      std::to_string(topology.triangles[std::size_t(bad)]) + " is past its " +
-                     std::to_string(garment.x.cols()) + " particles");
+                     std::to_string(garment.state.x.cols()) + " particles");
                 return;
             }
-            entry.buffers.create(GLsizei(garment.x.cols()), topology.triangles.data(), GLsizei(topology.triangles.size()));
+            entry.buffers.create(GLsizei(garment.state.x.cols()), topology.triangles.data(), GLsizei(topology.triangles.size()));
             entry.topology = &topology;
         }
-        compute_normals(garment.x, topology.triangles, entry.normals);
-        entry.buffers.upload(garment.x, entry.normals);
-        entry.color = garment.color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones());
+        compute_normals(garment.state.x, topology.triangles, entry.normals);
+        entry.buffers.upload(garment.state.x, entry.normals);
+        entry.color = garment.config.color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones());
     });
 
     // Free the buffers of entities that are gone.

@@ -45,22 +45,22 @@ EllipsoidFrame interpolate_collider(const EllipsoidCollider& collider, Real alph
     return frame;
 }
 
-void update_frames(const Registry& registry, Garment& garment, Real alpha) {
-    garment.frames.resize(garment.colliders.size());
-    for (std::size_t i = 0; i < garment.colliders.size(); ++i) {
-        const EllipsoidCollider* c = registry.try_get<EllipsoidCollider>(garment.colliders[i]);
+void update_frames(const Registry& registry, const GarmentBody& body, std::vector<EllipsoidFrame>& frames, Real alpha) {
+    frames.resize(body.colliders.size());
+    for (std::size_t i = 0; i < body.colliders.size(); ++i) {
+        const EllipsoidCollider* c = registry.try_get<EllipsoidCollider>(body.colliders[i]);
         if (c == nullptr) {
-            garment.frames[i].active = false;
+            frames[i].active = false;
             continue;
         }
-        garment.frames[i] = interpolate_collider(*c, alpha);
+        frames[i] = interpolate_collider(*c, alpha);
     }
 }
 
-Affine3 anchor_frame(const Garment& garment) {
+Affine3 anchor_frame(std::span<const EllipsoidFrame> frames, std::int32_t anchor) {
     Affine3 t = Affine3::Identity();
-    if (garment.anchor < 0 || static_cast<std::size_t>(garment.anchor) >= garment.frames.size()) return t;
-    const EllipsoidFrame& f = garment.frames[static_cast<std::size_t>(garment.anchor)];
+    if (anchor < 0 || static_cast<std::size_t>(anchor) >= frames.size()) return t;
+    const EllipsoidFrame& f = frames[static_cast<std::size_t>(anchor)];
     if (!f.active) return t;
     t.linear() = f.rotation;
     t.translation() = f.center;

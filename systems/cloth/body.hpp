@@ -13,6 +13,7 @@
 
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
+#include "systems/cloth/garment_solver.hpp"
 #include "engine/core/math.hpp"
 #include "engine/core/registry.hpp"
 
@@ -27,12 +28,12 @@ namespace drape {
 /// Unit-sphere -> world transform of a frame.
 [[nodiscard]] Affine3 unit_to_world(const EllipsoidFrame& frame);
 
-/// Refreshes `garment.frames` (one per entry of `garment.colliders`) at `alpha`.
+/// Refreshes `frames` (one per entry of `body.colliders`) at `alpha`.
 /// A collider whose entity is gone becomes inactive. No allocation once sized.
-void update_frames(const Registry& registry, Garment& garment, Real alpha);
+void update_frames(const Registry& registry, const GarmentBody& body, std::vector<EllipsoidFrame>& frames, Real alpha);
 
-/// Rigid frame (rotation + centre, no scale) of the garment's anchor collider, or identity.
-[[nodiscard]] Affine3 anchor_frame(const Garment& garment);
+/// Rigid frame (rotation + centre, no scale) of the anchor collider among `frames`, or identity.
+[[nodiscard]] Affine3 anchor_frame(std::span<const EllipsoidFrame> frames, std::int32_t anchor);
 
 /// Velocity of the body point at `x` carried by `frame`'s rigid motion: v_c + w x (x - c).
 [[nodiscard]] inline Vec3 body_velocity_at(const EllipsoidFrame& frame, const Vec3& x) {

@@ -651,23 +651,24 @@ bool has_reference(const Affine3& t) { return t.linear().squaredNorm() > 0; }
 
 }  // namespace
 
-void update_candidate_lists(Garment& g) {
-    const Eigen::Index n = g.x.cols();
-    const std::size_t e_count = std::min<std::size_t>(g.frames.size(), 64);
-    const Affine3 anchor = anchor_frame(g);
+void update_candidate_lists(Garment& g, GarmentSolver& solver) {
+    CandidateLists& lists = solver.lists;
+    const Eigen::Index n = g.state.x.cols();
+    const std::size_t e_count = std::min<std::size_t>(solver.frames.size(), 64);
+    const Affine3 anchor = anchor_frame(solver.frames, g.body.anchor);
     const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
-    const Real margin = g.material.candidate_margin_m;
-    auto& clearance = g.list_clearance_m;  // particle x ellipsoid, column e contiguous
-    VectorX& slack = g.list_slack_m;
+    const Real margin = g.config.material.candidate_margin_m;
+    auto& clearance = lists.clearance_m;  // particle x ellipsoid, column e contiguous
+    VectorX& slack = lists.slack_m;
     std::uint64_t tests = 0;
 
     // 1. Each particle's position and move d_p in the anchor frame (whole arrays).
-    Matrix3XRows& local = g.list_scratch;
+    Matrix3XRows& local = lists.scratch;
     local.resize(3, n);
     {
         // One pass with stride-3 loads; the rows of `local` are contiguous.
         const Vec3 t = anchor.translation();
-        const Real* x = g.x.data();
+        const Real* x = g.state.x.data();
         Real* l0 = local.row(0).data();
         Real* l1 = local.row(1).data();
         Real* l2 = local.row(2).data();
@@ -679,19 +680,19 @@ void update_candidate_lists(Garment& g) {
             l2[p] = r(2, 0) * a + r(2, 1) * b + r(2, 2) * c;
         }
     }
-    const bool valid = g.lists_valid && g.list_anchor_frames.size() == e_count && g.list_anchor_x.cols() == n &&
+    const bool valid = lists.valid && lists.reference_frames.size() == e_count && lists.reference_x.cols() == n &&
                        clearance.rows() == n && clearance.cols() == static_cast<Eigen::Index>(e_count) &&
-                       g.candidates.size() == static_cast<std::size_t>(n);
+                       lists.bits.size() == static_cast<std::size_t>(n);
     if (!valid) {  // everything from scratch: every particle and every ellipsoid is its own reference
-        g.candidates.assign(static_cast<std::size_t>(n), 0);
-        g.list_anchor_x = local;
-        g.list_anchor_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
+        lists.bits.assign(static_cast<std::size_t>(n), 0);
+        lists.reference_x = local;
+        lists.reference_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
         clearance.setConstant(n, static_cast<Eigen::Index>(e_count), std::numeric_limits<Real>::infinity());
         ++g.counters.list_rebuilds;
     }
     slack.resize(n);
     {
-        const auto d = (local - g.list_anchor_x).array();
+        const auto d = (local - lists.reference_x).array();
         slack = (d.row(0).square() + d.row(1).square() + d.row(2).square()).sqrt().transpose();
     }
 
@@ -701,24 +702,24 @@ void update_candidate_lists(Garment& g) {
     const Real ellipsoid_limit = ellipsoid_refresh_share * margin;
     std::array<Real, 64> moved_since{};
     for (std::size_t e = 0; e < e_count; ++e) {
-        Affine3& then = g.list_anchor_frames[e];
-        if (!g.frames[e].active) {
+        Affine3& then = lists.reference_frames[e];
+        if (!solver.frames[e].active) {
             if (has_reference(then)) {
-                for (std::uint64_t& c : g.candidates) c &= ~(std::uint64_t(1) << e);
+                for (std::uint64_t& c : lists.bits) c &= ~(std::uint64_t(1) << e);
                 clearance.col(static_cast<Eigen::Index>(e)).setConstant(std::numeric_limits<Real>::infinity());
                 then.matrix().setZero();
             }
             continue;
         }
-        const EllipsoidFrame current = in_anchor_frame(g.frames[e], anchor);
+        const EllipsoidFrame current = in_anchor_frame(solver.frames[e], anchor);
         const Affine3 now = unit_to_world(current);
         const Real moved = has_reference(then) ? ellipsoid_move(now, then) : std::numeric_limits<Real>::infinity();
         if (moved <= ellipsoid_limit) {
             moved_since[e] = moved;
             continue;
         }
-        if (!bounds) bounds.emplace(g.list_anchor_x);
-        tests += refresh_bit(g.list_anchor_x, *bounds, ListEllipsoid(current), e, margin, g.candidates,
+        if (!bounds) bounds.emplace(lists.reference_x);
+        tests += refresh_bit(lists.reference_x, *bounds, ListEllipsoid(current), e, margin, lists.bits,
                              clearance.col(static_cast<Eigen::Index>(e)).data());
         then = now;
     }
@@ -727,7 +728,7 @@ void update_candidate_lists(Garment& g) {
     //    clearance between their references: the slack is min_e (C_pe - D_e) - d_p, whole
     //    columns. A particle without slack becomes its own reference and is tested against
     //    every reference ellipsoid.
-    const std::uint64_t active = active_mask(g.frames);
+    const std::uint64_t active = active_mask(solver.frames);
     VectorX room = VectorX::Constant(n, std::numeric_limits<Real>::infinity());
     for_each_bit(active, [&](int e) {
         const Real* c = clearance.col(e).data();
@@ -747,7 +748,7 @@ void update_candidate_lists(Garment& g) {
         if (end - begin == 16 && Eigen::Map<const Eigen::Array<Real, 16, 1>>(slack.data() + begin).minCoeff() >= 0) continue;
         for (Eigen::Index p = begin; p < end; ++p) {
             spent[spent_count] = p;
-            spent_count += static_cast<std::size_t>(slack[p] < 0) & static_cast<std::size_t>(g.inv_mass[p] != 0);
+            spent_count += static_cast<std::size_t>(slack[p] < 0) & static_cast<std::size_t>(g.state.inv_mass[p] != 0);
         }
     }
     for (std::size_t k = 0; k < spent_count; ++k) {
@@ -756,33 +757,34 @@ void update_candidate_lists(Garment& g) {
             references.emplace(e_count);
             for_each_bit(active, [&](int e) {
                 const std::size_t ei = static_cast<std::size_t>(e);
-                references->set(ei, g.list_anchor_frames[ei], moved_since[ei]);
+                references->set(ei, lists.reference_frames[ei], moved_since[ei]);
             });
         }
-        g.list_anchor_x.col(p) = local.col(p);
+        lists.reference_x.col(p) = local.col(p);
         Real left = 0;
-        g.candidates[static_cast<std::size_t>(p)] = references->test(local.col(p), margin, stored, left);
+        lists.bits[static_cast<std::size_t>(p)] = references->test(local.col(p), margin, stored, left);
         for (std::size_t e = 0; e < e_count; ++e) clearance(p, static_cast<Eigen::Index>(e)) = stored[e];
         slack[p] = std::max(Real(0), left);
         tests += static_cast<std::uint64_t>(std::popcount(active));
     }
-    g.lists_valid = true;
+    lists.valid = true;
     g.counters.list_rebuild_tests += tests;
     g.counters.frame_list_rebuild_tests += tests;
 }
 
-CollisionResult collide_garment(Garment& g, DetectedPairs* detected, Real h) {
-    const Eigen::Index n = g.x.cols();
+CollisionResult collide_garment(Garment& g, GarmentSolver& solver, DetectedPairs* detected, Real h) {
+    const Eigen::Index n = g.state.x.cols();
     const std::vector<std::uint64_t>* lists = nullptr;
     std::span<const Real> slack;
-    if (g.collision == CollisionMode::candidate_lists) {
-        update_candidate_lists(g);
-        lists = &g.candidates;
-        slack = std::span<const Real>(g.list_slack_m.data(), static_cast<std::size_t>(g.list_slack_m.size()));
+    if (g.config.collision == CollisionMode::candidate_lists) {
+        update_candidate_lists(g, solver);
+        lists = &solver.lists.bits;
+        slack = std::span<const Real>(solver.lists.slack_m.data(), static_cast<std::size_t>(solver.lists.slack_m.size()));
     }
-    const bool have_start = h > 0 && g.x_start.cols() == n;
-    const CollisionResult r = collide_particles(g.x, g.v, g.inv_mass, g.frames, lists, g.last_collided, detected,
-                                                have_start ? &g.x_start : nullptr, h, slack);
+    const bool have_start = h > 0 && solver.x_start.cols() == n;
+    const CollisionResult r = collide_particles(g.state.x, g.state.v, g.state.inv_mass, solver.frames, lists,
+                                                solver.last_collided, detected, have_start ? &solver.x_start : nullptr, h,
+                                                slack);
     g.counters.frame_collision_tests += r.tests;
     g.counters.collision_tests += r.tests;
     g.counters.frame_collisions += r.collisions;

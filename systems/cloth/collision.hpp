@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "components/garment.hpp"
+#include "systems/cloth/garment_solver.hpp"
 #include "engine/core/math.hpp"
 
 namespace drape {
@@ -71,11 +72,11 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
                                     std::vector<std::uint64_t>& candidates);
 
 /// Step 1 for a garment: brings its candidate lists up to date for its current positions
-/// and frames (everything when `lists_valid` is false or the sizes changed, else the bits
-/// of ellipsoids and the lists of particles whose bound is spent), adds the tests to its
-/// counters and leaves in `list_slack_m` how far each free particle may still move before
-/// its list could miss an ellipsoid (>= 0).
-void update_candidate_lists(Garment& garment);
+/// and the solver's frames (everything when the lists are not valid or the sizes changed,
+/// else the bits of ellipsoids and the lists of particles whose bound is spent), adds the
+/// tests to its counters and leaves in `lists.slack_m` how far each free particle may still
+/// move before its list could miss an ellipsoid (>= 0).
+void update_candidate_lists(Garment& garment, GarmentSolver& solver);
 
 /// What a collision pass did.
 struct CollisionResult {
@@ -106,8 +107,8 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                                                std::span<const EllipsoidFrame> frames);
 
 /// Whole garment: brings the lists up to date (update_candidate_lists) in list mode, then
-/// collides in the garment's mode and adds to its counters. Frames must be current.
-/// h_s > 0: velocities of colliding particles from their move since `garment.x_start`.
-CollisionResult collide_garment(Garment& garment, DetectedPairs* detected = nullptr, Real h_s = 0);
+/// collides in the garment's mode and adds to its counters. The solver's frames must be
+/// current. h_s > 0: velocities of colliding particles from their move since `solver.x_start`.
+CollisionResult collide_garment(Garment& garment, GarmentSolver& solver, DetectedPairs* detected = nullptr, Real h_s = 0);
 
 }  // namespace drape

@@ -79,24 +79,24 @@ Result<void> validate_tube(std::string_view p, int lines, int per_line, int stri
 }
 
 // Particle-order positions from grid-order positions.
-Matrix3X to_particle_order(const GarmentTopology& t, const Matrix3X& grid_positions) {
+Matrix3X to_particle_order(const Fabric& t, const Matrix3X& grid_positions) {
     Matrix3X x(3, grid_positions.cols());
     for (Eigen::Index k = 0; k < grid_positions.cols(); ++k) x.col(t.grid[static_cast<std::size_t>(k)]) = grid_positions.col(k);
     return x;
 }
 
-Garment make_instance(std::shared_ptr<const GarmentTopology> topology, Matrix3X x, const ClothMaterial& material,
+Garment make_instance(std::shared_ptr<const Fabric> fabric, Matrix3X x, const ClothMaterial& material,
                       ClothModel model, CollisionMode collision, const Vec3& color) {
     Garment g;
     const Eigen::Index n = x.cols();
-    g.topology = std::move(topology);
-    g.x = std::move(x);
-    g.v = Matrix3X::Zero(3, n);
-    g.inv_mass = VectorX::Constant(n, Real(n) / material.mass_kg);
-    g.material = material;
-    g.model = model;
-    g.collision = collision;
-    g.color = color;
+    g.fabric = std::move(fabric);
+    g.state.x = std::move(x);
+    g.state.v = Matrix3X::Zero(3, n);
+    g.state.inv_mass = VectorX::Constant(n, Real(n) / material.mass_kg);
+    g.config.material = material;
+    g.config.model = model;
+    g.config.collision = collision;
+    g.config.color = color;
     return g;
 }
 
@@ -199,27 +199,30 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
 // Pins `rows` rows, pushes the rest out of the colliders, records the rest shape, and
 // adds the garment to the registry.
 Result<Entity> finish(Registry& registry, Garment g, int rows) {
-    const GarmentTopology& t = *g.topology;
-    update_frames(registry, g, 1);
+    const Fabric& t = *g.fabric;
+    GarmentSolver solver;
+    GarmentState& state = g.state;
+    update_frames(registry, g.body, solver.frames, 1);
     for (std::uint32_t line = 0; line < t.warp_lines; ++line) {
         for (std::uint32_t row = 0; row < static_cast<std::uint32_t>(rows); ++row) {
             const std::uint32_t p = t.grid[line * t.particles_per_line + row];
-            g.inv_mass[p] = 0;
-            g.pins.push_back(bind_pin(registry, g.body, g.colliders, g.frames, p, g.x.col(p)));
+            state.inv_mass[p] = 0;
+            state.pins.push_back(bind_pin(registry, g.body.character, g.body.colliders, solver.frames, p, state.x.col(p)));
         }
     }
-    for (const PinBinding& pin : g.pins)
-        if (auto at = evaluate_pin(registry, g, pin)) g.x.col(pin.particle) = *at;
-    prepare_garment(g);
+    for (const PinBinding& pin : state.pins)
+        if (auto at = evaluate_pin(registry, g, pin)) state.x.col(pin.particle) = *at;
+    prepare_solver(g, solver);
     std::vector<std::uint64_t> last;
-    for (int pass = 0; pass < 4; ++pass) collide_particles(g.x, g.v, g.inv_mass, g.frames, nullptr, last);
-    g.v.setZero();
-    const Affine3 anchor = anchor_frame(g);
-    g.rest_local = anchor.inverse(Eigen::Isometry) * g.x;
-    update_pin_targets(registry, g, true);
-    if (!g.x.allFinite()) return fail(std::string("garment placement produced non-finite positions"));
+    for (int pass = 0; pass < 4; ++pass) collide_particles(state.x, state.v, state.inv_mass, solver.frames, nullptr, last);
+    state.v.setZero();
+    const Affine3 anchor = anchor_frame(solver.frames, g.body.anchor);
+    g.body.rest_local = anchor.inverse(Eigen::Isometry) * state.x;
+    update_pin_targets(registry, g, solver, true);
+    if (!state.x.allFinite()) return fail(std::string("garment placement produced non-finite positions"));
     const Entity e = registry.create();
     registry.emplace<Garment>(e, std::move(g));
+    registry.emplace<GarmentSolver>(e, std::move(solver));
     return e;
 }
 
@@ -287,13 +290,13 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
     auto topology = build_grid_topology(n, m, s.stride, true, grid, s.name);
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
-    g.body = character;
-    g.colliders = colliders;
+    g.body.character = character;
+    g.body.colliders = colliders;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
     std::size_t anchor = outline.front();
     for (std::size_t e : outline)
         if ((frames[e].center - origin).norm() < (frames[anchor].center - origin).norm()) anchor = e;
-    g.anchor = static_cast<std::int32_t>(anchor);
+    g.body.anchor = static_cast<std::int32_t>(anchor);
     return finish(registry, std::move(g), s.fitting_rows);
 }
 
@@ -340,7 +343,7 @@ Result<void> validate(const RectangleParams& r) {
     return validate(r.material, "rectangle.material");
 }
 
-Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(int lines_in, int per_line_in, int stride_in,
+Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_line_in, int stride_in,
                                                                    bool closed, const Matrix3X& pos,
                                                                    std::string_view p) {
     if (auto ok = validate_grid(p, lines_in, per_line_in, stride_in, closed); !ok) return std::unexpected(ok.error());
@@ -351,7 +354,7 @@ Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(int lines_in,
                     std::to_string(m) + " grid");
     if (!pos.allFinite()) return fail(std::string(p) + ": non-finite rest positions");
 
-    auto t = std::make_shared<GarmentTopology>();
+    auto t = std::make_shared<Fabric>();
     t->warp_lines = n;
     t->particles_per_line = m;
     t->weft_stride = stride;
@@ -445,7 +448,7 @@ Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(int lines_in,
             const std::uint32_t p10 = at((line + 1) % n, row), p11 = at((line + 1) % n, row + 1);
             t->triangles.insert(t->triangles.end(), {p00, p01, p10, p10, p01, p11});
         }
-    return std::shared_ptr<const GarmentTopology>(std::move(t));
+    return std::shared_ptr<const Fabric>(std::move(t));
 }
 
 std::vector<Entity> character_colliders(Registry& registry, Entity character) {
@@ -489,19 +492,18 @@ Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity>
     auto topology = build_grid_topology(n, m, r.weft_stride, false, grid, "rectangle");
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), r.material, r.model, r.collision, r.color);
-    g.colliders.assign(colliders.begin(), colliders.end());
+    g.body.colliders.assign(colliders.begin(), colliders.end());
     if (r.pin_top_row)
         for (int line = 0; line < n; ++line) {
             const std::uint32_t p = (*topology)->grid[static_cast<std::size_t>(line * m)];
-            g.inv_mass[p] = 0;
+            g.state.inv_mass[p] = 0;
             PinBinding pin;
             pin.particle = p;
             pin.kind = PinKind::world;
-            pin.local = g.x.col(p);
-            g.pins.push_back(pin);
+            pin.local = g.state.x.col(p);
+            g.state.pins.push_back(pin);
         }
-    g.rest_local = g.x;
-    prepare_garment(g);
+    g.body.rest_local = g.state.x;
     return g;
 }
 
@@ -510,11 +512,16 @@ Result<Entity> attach_rectangle(Registry& registry, const RectangleParams& r, st
     if (!g) return std::unexpected(g.error());
     const Entity e = registry.create();
     registry.emplace<Garment>(e, std::move(*g));
+    registry.emplace<GarmentSolver>(e);
     return e;
 }
 
 void reset_garment(Registry& registry, Entity garment) {
-    if (Garment* g = registry.try_get<Garment>(garment)) reset_garment_state(registry, *g);
+    Garment* g = registry.try_get<Garment>(garment);
+    if (g == nullptr) return;
+    GarmentSolver* solver = registry.try_get<GarmentSolver>(garment);
+    if (solver == nullptr) solver = &registry.emplace<GarmentSolver>(garment);
+    reset_garment_state(registry, *g, *solver);
 }
 
 }  // namespace drape

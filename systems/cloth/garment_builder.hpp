@@ -95,7 +95,7 @@ inline constexpr int max_garment_particles = 250'000;
 [[nodiscard]] Result<void> validate(const ClothMaterial& material, std::string_view prefix);
 
 /// Cooks a grid topology from rest positions in grid order (column line * m + row).
-[[nodiscard]] Result<std::shared_ptr<const GarmentTopology>> build_grid_topology(
+[[nodiscard]] Result<std::shared_ptr<const Fabric>> build_grid_topology(
     int warp_lines, int particles_per_line, int weft_stride, bool closed, const Matrix3X& grid_positions,
     std::string_view prefix);
 

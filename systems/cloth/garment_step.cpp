@@ -1,4 +1,4 @@
-// Per-garment substep bodies of the cloth systems (method §3-§5); order in garment_step.hpp.
+// Per-garment stages of the cloth systems (method §3-§5); order in garment_step.hpp.
 #include "systems/cloth/garment_step.hpp"
 
 #include <algorithm>
@@ -14,107 +14,104 @@
 #include "systems/cloth/weft.hpp"
 
 namespace drape {
-void prepare_garment(Garment& g) {
-    const GarmentTopology& t = *g.topology;
-    const Eigen::Index n = static_cast<Eigen::Index>(t.particle_count());
-    if (g.force.cols() != n) g.force = Matrix3X::Zero(3, n);
-    if (g.normals.cols() != static_cast<Eigen::Index>(t.layer1_count)) g.normals = Matrix3X::Zero(3, t.layer1_count);
-    if (g.plane_normal.cols() != n) g.plane_normal = Matrix3X::Zero(3, n);
-    if (g.movable.size() != static_cast<std::size_t>(n)) {
-        g.movable.resize(static_cast<std::size_t>(n));
-        g.movable_weft.resize(static_cast<std::size_t>(n));
-        for (Eigen::Index i = 0; i < n; ++i) {
-            const std::size_t k = static_cast<std::size_t>(i);
-            g.movable[k] = g.inv_mass[i] != 0;
-            g.movable_weft[k] = g.inv_mass[i] != 0 && t.layer[k] == 2;
-        }
-    }
-    if (g.last_collided.size() != static_cast<std::size_t>(n)) g.last_collided.assign(static_cast<std::size_t>(n), 0);
+
+ClothSubstep make_substep(int index, int count, double fixed_dt_s) noexcept {
+    return ClothSubstep{index, count, fixed_dt_s, fixed_dt_s / count};
 }
 
-void integrate_garment(const Registry& registry, Garment& g, const FrameContext& ctx) {
-    prepare_garment(g);
-    const GarmentTopology& t = *g.topology;
-    const Real h = static_cast<Real>(ctx.h_s);
-    if (ctx.substep == 0) {
-        GarmentCounters& c = g.counters;
-        c.frame_collision_tests = c.frame_collisions = c.frame_list_rebuild_tests = 0;
-        c.max_penetration_m = 0;
-        c.substeps = ctx.substeps;
-        ++c.steps;
-        update_pin_targets(registry, g, false);
-    }
+void begin_garment_step(const Registry& registry, Garment& g, GarmentSolver& s, int substeps) {
+    prepare_solver(g, s);
+    GarmentCounters& c = g.counters;
+    c.frame_collision_tests = c.frame_collisions = c.frame_list_rebuild_tests = 0;
+    c.max_penetration_m = 0;
+    c.substeps = substeps;
+    ++c.steps;
+    update_pin_targets(registry, g, s, false);
+}
 
-    g.x_start = g.x;  // no allocation once sized
+void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    prepare_solver(g, s);
+    const Fabric& t = *g.fabric;
+    GarmentState& state = g.state;
+    const Real h = static_cast<Real>(sub.h_s);
+
+    s.x_start = state.x;  // no allocation once sized
     // The body part carrying the garment at the start of the substep (method §3.3).
     BodyMotion body;
-    if (g.anchor >= 0 && static_cast<std::size_t>(g.anchor) < g.colliders.size()) {
-        if (const auto* c = registry.try_get<EllipsoidCollider>(g.colliders[static_cast<std::size_t>(g.anchor)])) {
-            const EllipsoidFrame f = interpolate_collider(*c, Real(ctx.substep) / Real(ctx.substeps));
+    const GarmentBody& worn = g.body;
+    if (worn.anchor >= 0 && static_cast<std::size_t>(worn.anchor) < worn.colliders.size()) {
+        if (const auto* c = registry.try_get<EllipsoidCollider>(worn.colliders[static_cast<std::size_t>(worn.anchor)])) {
+            const EllipsoidFrame f = interpolate_collider(*c, Real(sub.index) / Real(sub.count));
             body = BodyMotion{f.center, f.velocity_m_s, f.acceleration_m_s2, f.angular_velocity_rad_s};
         }
     }
     const Vec3 gravity(0, -standard_gravity_m_s2, 0);
-    const ClothMaterial& m = g.material;
-    if (g.model == ClothModel::simplified) {
+    const ClothMaterial& m = g.config.material;
+    if (g.config.model == ClothModel::simplified) {
         const Eigen::Index count = static_cast<Eigen::Index>(t.layer1_count);
         const Real scale = t.layer1_mass_scale;
-        g.force.leftCols(count).setZero();
-        add_spring_forces(t.warp1, m.stretch_k_N_m * scale, g.x, g.force);
-        add_spring_forces(t.weft1, m.stretch_k_N_m, g.x, g.force);
-        integrate_particles(g.x, g.v, g.inv_mass, g.force, count, scale, m.drag_N_s_m, body, gravity, h);
+        s.force.leftCols(count).setZero();
+        add_spring_forces(t.warp1, m.stretch_k_N_m * scale, state.x, s.force);
+        add_spring_forces(t.weft1, m.stretch_k_N_m, state.x, s.force);
+        integrate_particles(state.x, state.v, state.inv_mass, s.force, count, scale, m.drag_N_s_m, body, gravity, h);
     } else {
-        g.force.setZero();
-        add_spring_forces(t.warp1, m.stretch_k_N_m, g.x, g.force);
-        add_spring_forces(t.warp2, m.stretch_k_N_m, g.x, g.force);
-        add_spring_forces(t.weft, m.stretch_k_N_m, g.x, g.force);
-        add_spring_forces(t.shear, m.shear_k_N_m, g.x, g.force);
-        add_spring_forces(t.bend, m.bend_k_N_m, g.x, g.force);
-        integrate_particles(g.x, g.v, g.inv_mass, g.force, g.x.cols(), 1, m.drag_N_s_m, body, gravity, h);
+        s.force.setZero();
+        add_spring_forces(t.warp1, m.stretch_k_N_m, state.x, s.force);
+        add_spring_forces(t.warp2, m.stretch_k_N_m, state.x, s.force);
+        add_spring_forces(t.weft, m.stretch_k_N_m, state.x, s.force);
+        add_spring_forces(t.shear, m.shear_k_N_m, state.x, s.force);
+        add_spring_forces(t.bend, m.bend_k_N_m, state.x, s.force);
+        integrate_particles(state.x, state.v, state.inv_mass, s.force, state.x.cols(), 1, m.drag_N_s_m, body, gravity, h);
     }
-    apply_pins(g, ctx.substep, ctx.substeps, static_cast<Real>(ctx.fixed_dt_s));
+    apply_pins(g, s, sub.index, sub.count, static_cast<Real>(sub.fixed_dt_s));
 }
 
-void constrain_garment(Garment& g, const FrameContext& ctx) {
-    prepare_garment(g);
-    const GarmentTopology& t = *g.topology;
+void constrain_garment(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    prepare_solver(g, s);
+    const Fabric& t = *g.fabric;
+    Matrix3X& x = g.state.x;
+    Matrix3X& v = g.state.v;
     StrainLimitOptions o;
-    o.limit = g.material.strain_limit;
-    o.iterations = g.material.strain_iterations;
-    o.h_s = static_cast<Real>(ctx.h_s);
-    if (g.model == ClothModel::simplified) {
+    o.limit = g.config.material.strain_limit;
+    o.iterations = g.config.material.strain_iterations;
+    o.h_s = static_cast<Real>(sub.h_s);
+    if (g.config.model == ClothModel::simplified) {
         // §4.1: layer 1, the weft springs between its lines symmetric only, then the warp
         // with its ordered pass last so that the 10 % bound holds exactly on the warp.
         StrainLimitOptions weft1 = o;
         weft1.ordered_pass = false;
-        limit_strain(t.weft1, g.x, g.v, g.movable, weft1);
-        limit_strain(t.warp1, g.x, g.v, g.movable, o);
+        limit_strain(t.weft1, x, v, s.movable, weft1);
+        limit_strain(t.warp1, x, v, s.movable, o);
         // §4.2: layer 2 placed in its planes from layer 1. Provot on the layer-2 springs
         // (item 3) is part of the placement: each particle's one free coordinate is kept where
         // its warp spring and weft segments hold the limit (weft.hpp), so after this no
         // layer-2 warp spring below a free particle exceeds 1.10 x rest either.
         // Under the fitting zone, chords out of reach of the pinned particle above them are
         // lifted first (weft.hpp); the layer-1 warp then gets its ordered pass again.
-        if (lift_chords_below_pins(t, g.inv_mass, g.x, g.v, g.force, o.h_s, o.limit)) {
+        if (lift_chords_below_pins(t, g.state.inv_mass, x, v, s.force, o.h_s, o.limit)) {
             StrainLimitOptions ordered = o;
             ordered.iterations = 0;
-            limit_strain(t.warp1, g.x, g.v, g.movable, ordered);
+            limit_strain(t.warp1, x, v, s.movable, ordered);
         }
-        compute_layer1_normals(t, g.x, g.normals);
-        place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, o.h_s, o.limit);
+        compute_layer1_normals(t, x, s.normals);
+        place_weft(t, s.normals, g.state.inv_mass, x, v, s.plane_normal, o.h_s, o.limit);
     } else {
         StrainLimitOptions weft = o;
         weft.ordered_pass = false;
-        limit_strain(t.weft, g.x, g.v, g.movable, weft);
-        limit_strain(t.warp1, g.x, g.v, g.movable, o);
-        limit_strain(t.warp2, g.x, g.v, g.movable, o);
+        limit_strain(t.weft, x, v, s.movable, weft);
+        limit_strain(t.warp1, x, v, s.movable, o);
+        limit_strain(t.warp2, x, v, s.movable, o);
     }
-    if (ctx.substep + 1 >= ctx.substeps)
-        g.counters.max_strain = std::max({max_strain(t.warp1, g.x), max_strain(t.warp2, g.x), max_strain(t.weft, g.x)});
+}
+
+void record_strain(Garment& g) {
+    const Fabric& t = *g.fabric;
+    const Matrix3X& x = g.state.x;
+    g.counters.max_strain = std::max({max_strain(t.warp1, x), max_strain(t.warp2, x), max_strain(t.weft, x)});
 }
 
 std::uint64_t count_non_finite(const Garment& g) {
-    return static_cast<std::uint64_t>((!g.x.array().isFinite()).count() + (!g.v.array().isFinite()).count());
+    return static_cast<std::uint64_t>((!g.state.x.array().isFinite()).count() + (!g.state.v.array().isFinite()).count());
 }
 
 namespace {
@@ -123,41 +120,61 @@ namespace {
 bool all_finite(const Matrix3X& m) { return !std::isnan((m.array() * 0).sum()); }
 }  // namespace
 
-void collide_garment_step(const Registry& registry, Garment& g, const FrameContext& context) {
-    prepare_garment(g);
-    update_frames(registry, g, Real(context.substep + 1) / Real(context.substeps));
-    const CollisionResult r = collide_garment(g, nullptr, static_cast<Real>(context.h_s));
+void collide_garment_step(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    prepare_solver(g, s);
+    update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
+    const CollisionResult r = collide_garment(g, s, nullptr, static_cast<Real>(sub.h_s));
     g.counters.unresolved += r.unresolved;
 
     // A NaN or infinity must not spread: report it once, count it, and start again from rest.
-    if (!all_finite(g.x) || !all_finite(g.v)) {
+    if (!all_finite(g.state.x) || !all_finite(g.state.v)) {
         const std::uint64_t bad = count_non_finite(g);
         g.counters.non_finite_values += bad;
         std::fprintf(stderr, "drape: cloth: %llu non-finite particle values after step %llu; garment reset to rest\n",
                      static_cast<unsigned long long>(bad), static_cast<unsigned long long>(g.counters.steps));
-        reset_garment_state(registry, g);
+        reset_garment_state(registry, g, s);
     }
 }
 
-void reset_garment_state(const Registry& registry, Garment& g) {
-    prepare_garment(g);
-    update_frames(registry, g, 1);
-    const Affine3 anchor = anchor_frame(g);
-    const Eigen::Index n = g.x.cols();
-    const bool has_anchor = g.anchor >= 0 && static_cast<std::size_t>(g.anchor) < g.frames.size() &&
-                            g.frames[static_cast<std::size_t>(g.anchor)].active;
+int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double fixed_dt_s,
+                 const ClothSolverSettings& settings, const StepHooks& hooks) {
+    const int substeps = garment_substeps(registry, g, s, fixed_dt_s, settings);
+    begin_garment_step(registry, g, s, substeps);
+    for (int i = 0; i < substeps; ++i) {
+        const ClothSubstep sub = make_substep(i, substeps, fixed_dt_s);
+        integrate_garment(registry, g, s, sub);
+        constrain_garment(g, s, sub);
+        if (sub.last()) record_strain(g);
+        if (hooks.after_constraints) hooks.after_constraints(g, s, sub);
+        if (hooks.collide)
+            hooks.collide(g, s, sub);
+        else
+            collide_garment_step(registry, g, s, sub);
+        if (hooks.after_collision) hooks.after_collision(g, s, sub);
+    }
+    return substeps;
+}
+
+void reset_garment_state(const Registry& registry, Garment& g, GarmentSolver& s) {
+    prepare_solver(g, s);
+    update_frames(registry, g.body, s.frames, 1);
+    const Affine3 anchor = anchor_frame(s.frames, g.body.anchor);
+    GarmentState& state = g.state;
+    const Eigen::Index n = state.x.cols();
+    const std::int32_t a = g.body.anchor;
+    const bool has_anchor = a >= 0 && static_cast<std::size_t>(a) < s.frames.size() && s.frames[static_cast<std::size_t>(a)].active;
     for (Eigen::Index p = 0; p < n; ++p) {
-        g.x.col(p) = anchor * Vec3(g.rest_local.col(p));
-        g.v.col(p) = has_anchor ? body_velocity_at(g.frames[static_cast<std::size_t>(g.anchor)], g.x.col(p)) : Vec3::Zero();
+        state.x.col(p) = anchor * Vec3(g.body.rest_local.col(p));
+        state.v.col(p) = has_anchor ? body_velocity_at(s.frames[static_cast<std::size_t>(a)], state.x.col(p)) : Vec3::Zero();
     }
-    update_pin_targets(registry, g, true);
-    for (std::size_t i = 0; i < g.pins.size(); ++i) {
-        const std::uint32_t p = g.pins[i].particle;
-        g.x.col(p) = g.pin_target.col(static_cast<Eigen::Index>(i));
+    update_pin_targets(registry, g, s, true);
+    for (std::size_t i = 0; i < state.pins.size(); ++i) {
+        const std::uint32_t p = state.pins[i].particle;
+        state.x.col(p) = s.pin_target.col(static_cast<Eigen::Index>(i));
     }
-    std::fill(g.last_collided.begin(), g.last_collided.end(), 0);
-    g.lists_valid = false;
-    collide_garment(g);
+    std::fill(s.last_collided.begin(), s.last_collided.end(), 0);
+    s.lists.valid = false;
+    collide_garment(g, s);
     ++g.counters.resets;
 }
 

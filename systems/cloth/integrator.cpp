@@ -42,7 +42,7 @@ void integrate_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, cons
     }
 }
 
-Real stable_step_s(const GarmentTopology& topology, const ClothMaterial& material, const VectorX& inv_mass,
+Real stable_step_s(const Fabric& topology, const ClothMaterial& material, const VectorX& inv_mass,
                    ClothModel model) {
     const Eigen::Index n = static_cast<Eigen::Index>(topology.particle_count());
     const bool simplified = model == ClothModel::simplified;

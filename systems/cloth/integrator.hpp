@@ -39,7 +39,7 @@ void integrate_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, cons
 /// Largest stable explicit step (method §3.4) of the garment under `model`: h = 2 / sqrt(lambda)
 /// with lambda the Gershgorin bound of M^-1 K over the integrated particles (each spring
 /// adds k to both ends' rows, twice when the other end moves too), also kept below m / k_drag.
-[[nodiscard]] Real stable_step_s(const GarmentTopology& topology, const ClothMaterial& material,
+[[nodiscard]] Real stable_step_s(const Fabric& topology, const ClothMaterial& material,
                                  const VectorX& inv_mass, ClothModel model);
 
 }  // namespace drape

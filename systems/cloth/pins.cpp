@@ -24,14 +24,14 @@ Result<Vec3> evaluate_pin(const Registry& registry, const Garment& garment, cons
     switch (pin.kind) {
         case PinKind::world: return pin.local;
         case PinKind::collider: {
-            if (pin.collider < 0 || static_cast<std::size_t>(pin.collider) >= garment.colliders.size())
+            if (pin.collider < 0 || static_cast<std::size_t>(pin.collider) >= garment.body.colliders.size())
                 return fail("pin " + std::to_string(pin.particle) + ": collider index out of range");
-            const auto* c = registry.try_get<EllipsoidCollider>(garment.colliders[static_cast<std::size_t>(pin.collider)]);
+            const auto* c = registry.try_get<EllipsoidCollider>(garment.body.colliders[static_cast<std::size_t>(pin.collider)]);
             if (c == nullptr) return fail("pin " + std::to_string(pin.particle) + ": its collider is gone");
             return Vec3(c->world * pin.local);
         }
         case PinKind::skinned: {
-            const auto* skeleton = registry.try_get<Skeleton>(garment.body);
+            const auto* skeleton = registry.try_get<Skeleton>(garment.body.character);
             if (skeleton == nullptr) return fail("pin " + std::to_string(pin.particle) + ": the body has no skeleton");
             for (int i = 0; i < 4; ++i)
                 if (pin.weights[i] != 0 &&
@@ -39,36 +39,37 @@ Result<Vec3> evaluate_pin(const Registry& registry, const Garment& garment, cons
                     return fail("pin " + std::to_string(pin.particle) + ": bone " + std::to_string(pin.bones[i]) +
                                 " has no skinning matrix");
             const Vec3 model = blend_skinning(skeleton->skinning, pin.bones, pin.weights) * pin.local;
-            const auto* transform = registry.try_get<Transform>(garment.body);
+            const auto* transform = registry.try_get<Transform>(garment.body.character);
             return transform ? Vec3(transform->matrix() * model) : model;
         }
     }
     return fail("pin: unknown kind");
 }
 
-void update_pin_targets(const Registry& registry, Garment& g, bool snap) {
-    const Eigen::Index n = static_cast<Eigen::Index>(g.pins.size());
-    const bool first = g.pin_target.cols() != n;
+void update_pin_targets(const Registry& registry, const Garment& g, GarmentSolver& s, bool snap) {
+    const std::vector<PinBinding>& pins = g.state.pins;
+    const Eigen::Index n = static_cast<Eigen::Index>(pins.size());
+    const bool first = s.pin_target.cols() != n;
     if (first) {
-        g.pin_target.resize(3, n);
-        for (Eigen::Index i = 0; i < n; ++i) g.pin_target.col(i) = g.x.col(g.pins[static_cast<std::size_t>(i)].particle);
+        s.pin_target.resize(3, n);
+        for (Eigen::Index i = 0; i < n; ++i) s.pin_target.col(i) = g.state.x.col(pins[static_cast<std::size_t>(i)].particle);
     }
-    g.pin_previous = g.pin_target;
+    s.pin_previous = s.pin_target;
     for (Eigen::Index i = 0; i < n; ++i) {
-        if (auto p = evaluate_pin(registry, g, g.pins[static_cast<std::size_t>(i)])) g.pin_target.col(i) = *p;
+        if (auto p = evaluate_pin(registry, g, pins[static_cast<std::size_t>(i)])) s.pin_target.col(i) = *p;
     }
-    if (first || snap) g.pin_previous = g.pin_target;
+    if (first || snap) s.pin_previous = s.pin_target;
 }
 
-void apply_pins(Garment& g, int substep, int substeps, Real fixed_dt) {
-    const Eigen::Index n = g.pin_target.cols();
+void apply_pins(Garment& g, const GarmentSolver& s, int substep, int substeps, Real fixed_dt) {
+    const Eigen::Index n = s.pin_target.cols();
     const bool last = substep + 1 >= substeps;
     const Real alpha = Real(substep + 1) / Real(substeps);
     for (Eigen::Index i = 0; i < n; ++i) {
-        const std::uint32_t p = g.pins[static_cast<std::size_t>(i)].particle;
-        g.x.col(p) = last ? Vec3(g.pin_target.col(i))
-                          : Vec3((1 - alpha) * g.pin_previous.col(i) + alpha * g.pin_target.col(i));
-        g.v.col(p) = (g.pin_target.col(i) - g.pin_previous.col(i)) / fixed_dt;
+        const std::uint32_t p = g.state.pins[static_cast<std::size_t>(i)].particle;
+        g.state.x.col(p) = last ? Vec3(s.pin_target.col(i))
+                                : Vec3((1 - alpha) * s.pin_previous.col(i) + alpha * s.pin_target.col(i));
+        g.state.v.col(p) = (s.pin_target.col(i) - s.pin_previous.col(i)) / fixed_dt;
     }
 }
 

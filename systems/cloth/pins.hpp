@@ -12,6 +12,7 @@
 #pragma once
 
 #include "components/garment.hpp"
+#include "systems/cloth/garment_solver.hpp"
 #include "engine/core/error.hpp"
 #include "engine/core/math.hpp"
 #include "engine/core/registry.hpp"
@@ -23,10 +24,10 @@ namespace drape {
 
 /// Sets every pin's target for the new fixed step (previous <- last target). On the first
 /// step, or when `snap`, previous = target. A pin that cannot be evaluated keeps its last target.
-void update_pin_targets(const Registry& registry, Garment& garment, bool snap);
+void update_pin_targets(const Registry& registry, const Garment& garment, GarmentSolver& solver, bool snap);
 
 /// Moves the pinned particles to fraction (substep + 1) / substeps of the step.
-void apply_pins(Garment& garment, int substep, int substeps, Real fixed_dt_s);
+void apply_pins(Garment& garment, const GarmentSolver& solver, int substep, int substeps, Real fixed_dt_s);
 
 /// Model-space skinning matrix blended from up to four bones (linear blend skinning).
 [[nodiscard]] Affine3 blend_skinning(const std::vector<Affine3>& skinning, const Vec4i& bones, const Vec4& weights);

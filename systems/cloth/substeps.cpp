@@ -10,31 +10,32 @@
 
 namespace drape {
 
-int garment_substeps(const Registry& registry, Garment& g, double fixed_dt, const ClothSolverSettings& s) {
-    if (!g.topology) return 1;
-    if (!g.stability_valid || !(g.cached_material == g.material)) {
-        g.stable_step_s[0] = stable_step_s(*g.topology, g.material, g.inv_mass, ClothModel::simplified);
-        g.stable_step_s[1] = stable_step_s(*g.topology, g.material, g.inv_mass, ClothModel::classic);
-        g.cached_material = g.material;
-        g.stability_valid = true;
+int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver, double fixed_dt,
+                     const ClothSolverSettings& s) {
+    if (!g.fabric) return 1;
+    prepare_solver(g, solver);
+    if (s.fixed_substeps > 0) {
+        g.counters.substeps_stability = g.counters.substeps_motion = s.fixed_substeps;
+        return s.fixed_substeps;
     }
     const double cap = std::max(1, s.max_substeps);
-    const double h_stable = double(g.stable_step_s[g.model == ClothModel::simplified ? 0 : 1]) * s.stability_safety;
+    const double h_stable = double(solver.stable_step_s[g.config.model == ClothModel::simplified ? 0 : 1]) * s.stability_safety;
     const double stability = std::isfinite(h_stable) && h_stable > 0 ? std::ceil(fixed_dt / h_stable) : cap;
 
     // Fastest collider surface the garment can touch, relative to its anchor.
     double speed = 0;
-    const EllipsoidCollider* anchor = g.anchor >= 0 && static_cast<std::size_t>(g.anchor) < g.colliders.size()
-        ? registry.try_get<EllipsoidCollider>(g.colliders[static_cast<std::size_t>(g.anchor)]) : nullptr;
+    const GarmentBody& body = g.body;
+    const EllipsoidCollider* anchor = body.anchor >= 0 && static_cast<std::size_t>(body.anchor) < body.colliders.size()
+        ? registry.try_get<EllipsoidCollider>(body.colliders[static_cast<std::size_t>(body.anchor)]) : nullptr;
     std::uint64_t reach = ~std::uint64_t(0);
-    if (g.collision == CollisionMode::candidate_lists && g.lists_valid) {
+    if (g.config.collision == CollisionMode::candidate_lists && solver.lists.valid) {
         reach = 0;
-        for (std::uint64_t c : g.candidates) reach |= c;
+        for (std::uint64_t c : solver.lists.bits) reach |= c;
     }
     const Vec3 anchor_c = anchor ? Vec3(anchor->world.translation()) : Vec3::Zero();
-    for (std::size_t e = 0; e < g.colliders.size() && e < 64; ++e) {
+    for (std::size_t e = 0; e < body.colliders.size() && e < 64; ++e) {
         if (!(reach >> e & 1)) continue;
-        const auto* c = registry.try_get<EllipsoidCollider>(g.colliders[e]);
+        const auto* c = registry.try_get<EllipsoidCollider>(body.colliders[e]);
         if (c == nullptr) continue;
         const Vec3 center = c->world.translation();
         Vec3 dv = c->velocity_m_s;
@@ -52,12 +53,6 @@ int garment_substeps(const Registry& registry, Garment& g, double fixed_dt, cons
     g.counters.substeps_stability = static_cast<int>(std::clamp(stability, 1.0, cap));
     g.counters.substeps_motion = static_cast<int>(std::clamp(motion, 1.0, cap));
     return std::max(g.counters.substeps_stability, g.counters.substeps_motion);
-}
-
-int cloth_substeps(Registry& registry, double fixed_dt, const ClothSolverSettings& s) {
-    int n = 1;
-    registry.view<Garment>().each([&](Entity, Garment& g) { n = std::max(n, garment_substeps(registry, g, fixed_dt, s)); });
-    return std::clamp(n, 1, std::max(1, s.max_substeps));
 }
 
 }  // namespace drape

@@ -1,7 +1,6 @@
-// How many simulation substeps a fixed step takes (method §3.4).
+// How many substeps a garment takes in one fixed step (method §3.4).
 //
-// Rule, per garment, then the largest over all garments (the scheduler runs one substep
-// count for the whole simulation phase):
+// Rule, per garment:
 //   stability: n_s = ceil(fixed_dt / (safety * h_stable)), h_stable = 2 / sqrt(lambda) with
 //              lambda the Gershgorin bound on M^-1 K of the springs the model integrates
 //              (the "h < 2 sqrt(m / k)" bound of one spring, generalised to a particle with
@@ -10,13 +9,15 @@
 //              of a collider the garment can touch, relative to the garment's anchor
 //              (|v_e - v_anchor(c_e)| + |w_e - w_anchor| * r_max), so that no collider
 //              surface moves more than max_surface_travel through the cloth per substep;
-//   n = clamp(max(n_s, n_m), 1, max_substeps).
+//   n = clamp(max(n_s, n_m), 1, max_substeps), or `fixed_substeps` when that is set.
+// The cloth systems run every garment with the largest need of all garments.
 // With the default material the 837-particle simplified skirt needs one substep for
 // stability; walking adds a second when a thigh swings faster than ~2.4 m/s.
 #pragma once
 
 #include "components/garment.hpp"
 #include "engine/core/registry.hpp"
+#include "systems/cloth/garment_solver.hpp"
 
 namespace drape {
 
@@ -24,12 +25,11 @@ struct ClothSolverSettings {
     Real stability_safety = Real(0.9);        ///< Fraction of the stability bound used.
     Real max_surface_travel_m = Real(0.04);   ///< Per substep.
     int max_substeps = 8;                     ///< Cap (cost bound when a body teleports).
+    int fixed_substeps = 0;                   ///< > 0: always this many substeps (benchmarks, sweeps).
 };
 
-/// Substeps one garment needs; also stores them in its counters.
-int garment_substeps(const Registry& registry, Garment& garment, double fixed_dt_s, const ClothSolverSettings& settings);
-
-/// The rule installed in the scheduler: the largest need of all garments (1 when none).
-int cloth_substeps(Registry& registry, double fixed_dt_s, const ClothSolverSettings& settings);
+/// Substeps one garment needs; also stores its needs in its counters.
+int garment_substeps(const Registry& registry, Garment& garment, GarmentSolver& solver, double fixed_dt_s,
+                     const ClothSolverSettings& settings);
 
 }  // namespace drape

@@ -9,7 +9,7 @@ namespace drape {
 namespace {
 
 // Unit normal of the plane of layer-2 particle k, or zero when degenerate.
-inline Vec3 plane_of(const GarmentTopology& t, const Matrix3X& normals, const Matrix3X& x, std::size_t k) {
+inline Vec3 plane_of(const Fabric& t, const Matrix3X& normals, const Matrix3X& x, std::size_t k) {
     const std::uint32_t a = t.weft_left[k], b = t.weft_right[k];
     const Vec3 edge = x.col(b) - x.col(a);
     const Vec3 n = normals.col(a) + normals.col(b);
@@ -20,7 +20,7 @@ inline Vec3 plane_of(const GarmentTopology& t, const Matrix3X& normals, const Ma
 
 }  // namespace
 
-void compute_layer1_normals(const GarmentTopology& t, const Matrix3X& x, Matrix3X& normals) {
+void compute_layer1_normals(const Fabric& t, const Matrix3X& x, Matrix3X& normals) {
     const std::size_t n = t.normal_up.size();
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3 warp = x.col(t.normal_down[i]) - x.col(t.normal_up[i]);
@@ -31,7 +31,7 @@ void compute_layer1_normals(const GarmentTopology& t, const Matrix3X& x, Matrix3
     }
 }
 
-void place_weft(const GarmentTopology& t, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,
+void place_weft(const Fabric& t, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,
                 Matrix3X& v, Matrix3X& plane_normal, Real h, Real limit) {
     constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
     const Real stride = Real(t.weft_stride);
@@ -114,7 +114,7 @@ void place_weft(const GarmentTopology& t, const Matrix3X& normals, const VectorX
     }
 }
 
-bool lift_chords_below_pins(const GarmentTopology& t, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
+bool lift_chords_below_pins(const Fabric& t, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
                             Matrix3X& scratch, Real h, Real limit) {
     constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
     constexpr int max_rounds = 32;
@@ -177,7 +177,7 @@ bool lift_chords_below_pins(const GarmentTopology& t, const VectorX& inv_mass, M
     return true;
 }
 
-Real weft_plane_distance(const GarmentTopology& t, const Matrix3X& normals, const Matrix3X& x, std::size_t k) {
+Real weft_plane_distance(const Fabric& t, const Matrix3X& normals, const Matrix3X& x, std::size_t k) {
     const Vec3 p = plane_of(t, normals, x, k);
     return p.dot(x.col(t.weft_particle[k]) - x.col(t.weft_left[k]));
 }

@@ -40,7 +40,7 @@
 namespace drape {
 
 /// Step 1: unit normals of the layer-1 particles (columns [0, layer1_count) of `normals`).
-void compute_layer1_normals(const GarmentTopology& topology, const Matrix3X& x, Matrix3X& normals);
+void compute_layer1_normals(const Fabric& topology, const Matrix3X& x, Matrix3X& normals);
 
 /// Before step 2, under the fitting zone (method §3.5): where a layer-2 particle hangs from a
 /// pinned one whose skin point lies farther than (1 + limit) x rest from the particle's chord
@@ -51,17 +51,17 @@ void compute_layer1_normals(const GarmentTopology& topology, const Matrix3X& x, 
 /// chord is then a place the particle may take, so the back-off of step 3 holds its warp
 /// spring too. `scratch`: 3 x layer1_count or more. True when anything moved: the layer-1 warp
 /// then needs its ordered Provot pass again (it leaves the springs from the pins as they are).
-bool lift_chords_below_pins(const GarmentTopology& topology, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
+bool lift_chords_below_pins(const Fabric& topology, const VectorX& inv_mass, Matrix3X& x, Matrix3X& v,
                             Matrix3X& scratch, Real h_s, Real strain_limit = Real(0.10));
 
 /// Steps 2-3: places the free layer-2 particles and writes each one's plane normal into
 /// `plane_normal` (zero for particles without a plane).
-void place_weft(const GarmentTopology& topology, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,
+void place_weft(const Fabric& topology, const Matrix3X& normals, const VectorX& inv_mass, Matrix3X& x,
                 Matrix3X& v, Matrix3X& plane_normal, Real h_s, Real strain_limit = Real(0.10));
 
 /// Signed distance of layer-2 particle `k` (index into topology.weft_particle) from its
 /// plane at the current positions, m (for tests and diagnostics).
-[[nodiscard]] Real weft_plane_distance(const GarmentTopology& topology, const Matrix3X& normals,
+[[nodiscard]] Real weft_plane_distance(const Fabric& topology, const Matrix3X& normals,
                                        const Matrix3X& x, std::size_t k);
 
 }  // namespace drape

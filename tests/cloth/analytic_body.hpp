@@ -5,15 +5,15 @@
 #pragma once
 
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <vector>
 
 #include "components/ellipsoid_collider.hpp"
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
-#include "systems/cloth/cloth_systems.hpp"
 #include "systems/cloth/garment_step.hpp"
-#include "systems/cloth/substeps.hpp"
+#include "systems/cloth_systems.hpp"
 
 namespace drape::test {
 
@@ -146,36 +146,28 @@ struct WalkingScene {
     Scheduler scheduler;
 };
 
-// Steps garment `g` on `body` by hand for `frames` fixed 1/60 s steps, each split into the
-// cloth's substeps (method §3.4) and run in the cloth systems' order: integrate, constrain,
-// `after_constraints(g, ctx, frame)`, then `collide(g, ctx, frame)` (by default the
-// collision system's step), so that tests can look between the systems. `hold_pose`: the
-// body keeps its pose of t = 0 instead of walking.
-template <class After, class Collide>
-void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, int frames, After&& after_constraints,
-                  Collide&& collide, bool hold_pose = false) {
+/// What a test runs between the systems: the garment, its solver, the substep and the frame.
+using StageCheck = std::function<void(Garment&, GarmentSolver&, const ClothSubstep&, int frame)>;
+
+// Steps garment `g` on `body` by hand for `frames` fixed 1/60 s steps through step_garment
+// (the cloth systems' order and substeps), the body posed before each step.
+// `after_constraints` runs right after the constraint system of every substep; `collide`,
+// when given, replaces the collision system. `hold_pose`: the body keeps its pose of t = 0
+// instead of walking.
+inline void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, GarmentSolver& solver, int frames,
+                         const StageCheck& after_constraints = {}, const StageCheck& collide = {}, bool hold_pose = false) {
     const double dt = 1.0 / 60.0;
     for (int frame = 0; frame < frames; ++frame) {
         body.place(registry, hold_pose ? 0.0 : (frame + 1) * dt, false, dt);
-        const int substeps = garment_substeps(registry, g, dt, ClothSolverSettings{});
-        FrameContext ctx;
-        ctx.fixed_dt_s = dt;
-        ctx.substeps = substeps;
-        ctx.h_s = dt / substeps;
-        for (int s = 0; s < substeps; ++s) {
-            ctx.substep = s;
-            integrate_garment(registry, g, ctx);
-            constrain_garment(g, ctx);
-            after_constraints(g, ctx, frame);
-            collide(g, ctx, frame);
-        }
+        StepHooks hooks;
+        if (after_constraints)
+            hooks.after_constraints = [&](Garment& garment, GarmentSolver& s, const ClothSubstep& sub) {
+                after_constraints(garment, s, sub, frame);
+            };
+        if (collide)
+            hooks.collide = [&](Garment& garment, GarmentSolver& s, const ClothSubstep& sub) { collide(garment, s, sub, frame); };
+        step_garment(registry, g, solver, dt, ClothSolverSettings{}, hooks);
     }
-}
-
-template <class After>
-void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, int frames, After&& after_constraints) {
-    step_by_hand(body, registry, g, frames, after_constraints,
-                 [&](Garment& garment, const FrameContext& ctx, int) { collide_garment_step(registry, garment, ctx); });
 }
 
 }  // namespace drape::test

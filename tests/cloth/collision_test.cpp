@@ -107,7 +107,8 @@ test::WalkSettings fast_walk() {
     return walk;
 }
 
-// Walks a garment through a whole walk cycle, calling `check` around every collision pass.
+// Walks a garment through a whole walk cycle, calling `check(garment, solver, before)` around
+// every collision pass.
 template <class F>
 void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dress = default_skirt,
                 test::WalkSettings walk = {}) {
@@ -115,15 +116,16 @@ void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dr
     test::AnalyticBody body(registry, walk);
     const Entity e = dress(registry, body.character, model, mode);
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     const int frames = static_cast<int>(walk.period_s / (1.0 / 60.0)) + 1;
     test::step_by_hand(
-        body, registry, g, frames, [](Garment&, const FrameContext&, int) {},
-        [&](Garment& garment, const FrameContext& ctx, int) {
-            update_frames(registry, garment, Real(ctx.substep + 1) / Real(ctx.substeps));
-            check(garment, /*before=*/true);
-            const CollisionResult r = collide_garment(garment, nullptr, static_cast<Real>(ctx.h_s));
+        body, registry, g, solver, frames, test::StageCheck{},
+        [&](Garment& garment, GarmentSolver& s, const ClothSubstep& ctx, int) {
+            update_frames(registry, garment.body, s.frames, Real(ctx.index + 1) / Real(ctx.count));
+            check(garment, s, /*before=*/true);
+            const CollisionResult r = collide_garment(garment, s, nullptr, static_cast<Real>(ctx.h_s));
             garment.counters.unresolved += r.unresolved;
-            check(garment, /*before=*/false);
+            check(garment, s, /*before=*/false);
         });
 }
 
@@ -133,18 +135,19 @@ std::array<std::uint64_t, 3> compare_with_brute_force(ClothModel model, const Dr
     std::uint64_t contacts = 0, list_tests = 0, brute_tests = 0;
     walk_cycle(
         model, CollisionMode::candidate_lists,
-        [&](Garment& g, bool before) {
+        [&](Garment& g, GarmentSolver& s, bool before) {
             if (!before) return;
-            const DetectedPairs expected = detect_brute_force(g.x, g.inv_mass, g.frames);
+            const DetectedPairs expected = detect_brute_force(g.state.x, g.state.inv_mass, s.frames);
             Garment copy = g;
+            GarmentSolver copy_solver = s;
             DetectedPairs found;
             const std::uint64_t tests_before = copy.counters.collision_tests;
-            collide_garment(copy, &found);
+            collide_garment(copy, copy_solver, &found);
             ASSERT_EQ(found.size(), expected.size());
             for (std::size_t p = 0; p < found.size(); ++p) ASSERT_EQ(found[p], expected[p]) << "particle " << p;
             for (std::uint64_t bits : expected) contacts += static_cast<std::uint64_t>(std::popcount(bits));
             list_tests += copy.counters.collision_tests - tests_before;
-            brute_tests += static_cast<std::uint64_t>(g.x.cols()) * g.frames.size();
+            brute_tests += static_cast<std::uint64_t>(g.state.x.cols()) * s.frames.size();
         },
         dress, walk);
     return {contacts, list_tests, brute_tests};
@@ -273,33 +276,35 @@ TEST(CandidateLists, OnlyTheEllipsoidsThatMovedAreRefreshed) {
     test::AnalyticBody body(registry, still);
     const Entity e = default_skirt(registry, body.character, ClothModel::simplified, CollisionMode::candidate_lists);
     Garment& g = registry.get<Garment>(e);
-    update_frames(registry, g, 1);
-    g.lists_valid = false;
-    update_candidate_lists(g);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
+    update_frames(registry, g.body, solver.frames, 1);
+    solver.lists.valid = false;
+    update_candidate_lists(g, solver);
     const std::uint64_t rebuilds = g.counters.list_rebuilds;
     const std::uint64_t full = g.counters.list_rebuild_tests;
     EXPECT_GT(full, 0u);
-    update_candidate_lists(g);
+    update_candidate_lists(g, solver);
     EXPECT_EQ(g.counters.list_rebuild_tests, full);  // nothing moved: nothing refreshed
 
     const Entity forearm_entity = body.colliders[6];  // analytic body: left forearm
     std::size_t forearm = 0;
-    while (forearm < g.colliders.size() && g.colliders[forearm] != forearm_entity) ++forearm;
-    ASSERT_LT(forearm, g.colliders.size());
+    while (forearm < g.body.colliders.size() && g.body.colliders[forearm] != forearm_entity) ++forearm;
+    ASSERT_LT(forearm, g.body.colliders.size());
     auto& c = registry.get<EllipsoidCollider>(forearm_entity);
     c.world.translation() += Vec3(0, 0, Real(0.06));  // 6 cm > margin / 2 = 4 cm
-    update_frames(registry, g, 1);
-    const std::vector<std::uint64_t> lists = g.candidates;
-    update_candidate_lists(g);
+    update_frames(registry, g.body, solver.frames, 1);
+    const std::vector<std::uint64_t> lists = solver.lists.bits;
+    update_candidate_lists(g, solver);
     EXPECT_EQ(g.counters.list_rebuilds, rebuilds);                                    // no full rebuild
-    EXPECT_LT(g.counters.list_rebuild_tests - full, static_cast<std::uint64_t>(g.x.cols()));  // part of one bit
+    EXPECT_LT(g.counters.list_rebuild_tests - full, static_cast<std::uint64_t>(g.state.x.cols()));  // part of one bit
     const std::uint64_t others = ~(std::uint64_t(1) << forearm);
-    for (std::size_t p = 0; p < lists.size(); ++p) EXPECT_EQ(g.candidates[p] & others, lists[p] & others);
+    for (std::size_t p = 0; p < lists.size(); ++p) EXPECT_EQ(solver.lists.bits[p] & others, lists[p] & others);
     // And the lists still find exactly what brute force finds.
-    const DetectedPairs expected = detect_brute_force(g.x, g.inv_mass, g.frames);
+    const DetectedPairs expected = detect_brute_force(g.state.x, g.state.inv_mass, solver.frames);
     DetectedPairs found;
     Garment copy = g;
-    collide_garment(copy, &found);
+    GarmentSolver copy_solver = solver;
+    collide_garment(copy, copy_solver, &found);
     EXPECT_EQ(found, expected);
 }
 
@@ -307,16 +312,16 @@ class CollisionOnWalk : public ::testing::TestWithParam<ClothModel> {};
 
 TEST_P(CollisionOnWalk, NoFreeParticleInsideAnyEllipsoidAfterCollision) {
     std::uint64_t collisions = 0;
-    walk_cycle(GetParam(), CollisionMode::candidate_lists, [&](Garment& g, bool before) {
+    walk_cycle(GetParam(), CollisionMode::candidate_lists, [&](Garment& g, GarmentSolver& s, bool before) {
         if (before) return;
         collisions = g.counters.collisions;
-        for (Eigen::Index p = 0; p < g.x.cols(); ++p) {
-            if (g.inv_mass[p] == 0) continue;
+        for (Eigen::Index p = 0; p < g.state.x.cols(); ++p) {
+            if (g.state.inv_mass[p] == 0) continue;
             EXPECT_EQ(g.counters.unresolved, 0u);
-            for (std::size_t e = 0; e < g.frames.size(); ++e)
-                ASSERT_LE(penetration_depth(g.frames[e], g.x.col(p)), 1e-5)
-                    << "particle " << p << " ellipsoid " << e << " list " << std::hex << g.candidates[std::size_t(p)]
-                    << " last " << g.last_collided[std::size_t(p)];
+            for (std::size_t e = 0; e < s.frames.size(); ++e)
+                ASSERT_LE(penetration_depth(s.frames[e], g.state.x.col(p)), 1e-5)
+                    << "particle " << p << " ellipsoid " << e << " list " << std::hex << s.lists.bits[std::size_t(p)]
+                    << " last " << s.last_collided[std::size_t(p)];
         }
     });
     EXPECT_GT(collisions, 100u);
@@ -355,20 +360,21 @@ TEST_P(CollisionOnWalk, AParticleMovedByItsSlackStaysOutOfEveryEllipsoidItsListL
     std::uint64_t checked = 0;
     walk_cycle(
         GetParam(), CollisionMode::candidate_lists,
-        [&](Garment& g, bool before) {
+        [&](Garment& g, GarmentSolver& s, bool before) {
             if (!before) return;
             Garment copy = g;
-            update_candidate_lists(copy);
-            ASSERT_EQ(copy.list_slack_m.size(), copy.x.cols());
-            for (Eigen::Index p = 0; p < copy.x.cols(); ++p) {
-                if (copy.inv_mass[p] == 0) continue;
-                const Real slack = copy.list_slack_m[p];
+            GarmentSolver copy_solver = s;
+            update_candidate_lists(copy, copy_solver);
+            ASSERT_EQ(copy_solver.lists.slack_m.size(), copy.state.x.cols());
+            for (Eigen::Index p = 0; p < copy.state.x.cols(); ++p) {
+                if (copy.state.inv_mass[p] == 0) continue;
+                const Real slack = copy_solver.lists.slack_m[p];
                 ASSERT_GE(slack, 0) << "particle " << p;
-                const std::uint64_t unlisted = active_mask(copy.frames) & ~copy.candidates[static_cast<std::size_t>(p)];
-                for (std::size_t e = 0; e < copy.frames.size(); ++e) {
+                const std::uint64_t unlisted = active_mask(copy_solver.frames) & ~copy_solver.lists.bits[static_cast<std::size_t>(p)];
+                for (std::size_t e = 0; e < copy_solver.frames.size(); ++e) {
                     if (!(unlisted >> e & 1)) continue;
-                    const EllipsoidFrame& f = copy.frames[e];
-                    const Vec3 x = copy.x.col(p);
+                    const EllipsoidFrame& f = copy_solver.frames[e];
+                    const Vec3 x = copy.state.x.col(p);
                     const Vec3 toward = (f.center - x).normalized();
                     ASSERT_GE(to_unit_sphere(f, x + slack * toward).squaredNorm(), 1) << "particle " << p << " ellipsoid " << e;
                     for (const Vec3& d : directions)

@@ -16,13 +16,13 @@ namespace {
 // two pinned particles the skin decides); returns how many layer-2 warp springs hanging from
 // a pinned particle it checked.
 std::size_t expect_warp_within_limit(const Garment& g) {
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     std::size_t below_pins = 0;
     for (const SpringPhase* warp : {&t.warp1, &t.warp2}) {
         for (std::size_t s = 0; s < warp->size(); ++s) {
-            const bool pinned_a = g.inv_mass[warp->a[s]] == 0, pinned_b = g.inv_mass[warp->b[s]] == 0;
+            const bool pinned_a = g.state.inv_mass[warp->a[s]] == 0, pinned_b = g.state.inv_mass[warp->b[s]] == 0;
             if (pinned_a && pinned_b) continue;
-            const Real length = (g.x.col(warp->b[s]) - g.x.col(warp->a[s])).norm();
+            const Real length = (g.state.x.col(warp->b[s]) - g.state.x.col(warp->a[s])).norm();
             EXPECT_LE(length, Real(1.10) * warp->rest_m[s] * Real(1 + 1e-5) + Real(1e-6))
                 << (warp == &t.warp1 ? "layer-1" : "layer-2") << " warp spring " << s << (pinned_a ? " below a pin" : "");
             if (length > Real(1.10) * warp->rest_m[s] * Real(1 + 1e-5) + Real(1e-6)) return below_pins;
@@ -44,9 +44,10 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringLongerThanTenPercentAfterTheConstra
     params.model = GetParam();
     const Entity e = *attach_skirt(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     int checks = 0;
     std::size_t below_pins = 0;
-    test::step_by_hand(body, registry, g, 120, [&](Garment& garment, const FrameContext&, int) {
+    test::step_by_hand(body, registry, g, solver, 120, [&](Garment& garment, GarmentSolver&, const ClothSubstep&, int) {
         if (::testing::Test::HasFailure()) return;
         below_pins += expect_warp_within_limit(garment);
         ++checks;
@@ -64,21 +65,22 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringOfAWalkingDressLongerThanTenPercent
     params.model = GetParam();
     const Entity e = *attach_dress(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     int checks = 0;
     std::size_t below_pins = 0;
     const bool simplified = GetParam() == ClothModel::simplified;
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     Matrix3X normals(3, t.layer1_count);
     std::size_t on_planes = 0;
-    test::step_by_hand(body, registry, g, simplified ? 120 : 60, [&](Garment& garment, const FrameContext&, int) {
+    test::step_by_hand(body, registry, g, solver, simplified ? 120 : 60, [&](Garment& garment, GarmentSolver&, const ClothSubstep&, int) {
         if (::testing::Test::HasFailure()) return;
         below_pins += expect_warp_within_limit(garment);
         ++checks;
         if (!simplified) return;
-        compute_layer1_normals(t, garment.x, normals);
+        compute_layer1_normals(t, garment.state.x, normals);
         for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
-            if (garment.inv_mass[t.weft_particle[k]] == 0) continue;
-            ASSERT_NEAR(weft_plane_distance(t, normals, garment.x, k), 0, 1e-5) << "layer-2 entry " << k;
+            if (garment.state.inv_mass[t.weft_particle[k]] == 0) continue;
+            ASSERT_NEAR(weft_plane_distance(t, normals, garment.state.x, k), 0, 1e-5) << "layer-2 entry " << k;
             ++on_planes;
         }
     });
@@ -96,10 +98,11 @@ TEST_P(ConstraintOnWalkingSkirt, PinnedParticlesAreNeverMovedByTheConstraints) {
     params.model = GetParam();
     const Entity e = *attach_skirt(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
-    test::step_by_hand(body, registry, g, 30, [&](Garment& garment, const FrameContext& ctx, int) {
-        if (ctx.substep + 1 < ctx.substeps) return;  // mid-step pins are between two targets
-        for (Eigen::Index i = 0; i < garment.pin_target.cols(); ++i)
-            ASSERT_EQ(garment.x.col(garment.pins[static_cast<std::size_t>(i)].particle), garment.pin_target.col(i));
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
+    test::step_by_hand(body, registry, g, solver, 30, [&](Garment& garment, GarmentSolver& s, const ClothSubstep& ctx, int) {
+        if (!ctx.last()) return;  // mid-step pins are between two targets
+        for (Eigen::Index i = 0; i < s.pin_target.cols(); ++i)
+            ASSERT_EQ(garment.state.x.col(garment.state.pins[static_cast<std::size_t>(i)].particle), s.pin_target.col(i));
     });
 }
 
@@ -112,14 +115,15 @@ TEST(Weft, LayerTwoParticlesLieOnTheirPlanesAfterTheConstraintSystem) {
     test::AnalyticBody body(registry);
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
-    const GarmentTopology& t = *g.topology;
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
+    const Fabric& t = *g.fabric;
     Matrix3X normals(3, t.layer1_count);
     std::size_t checked = 0;
-    test::step_by_hand(body, registry, g, 90, [&](Garment& garment, const FrameContext&, int) {
-        compute_layer1_normals(t, garment.x, normals);
+    test::step_by_hand(body, registry, g, solver, 90, [&](Garment& garment, GarmentSolver&, const ClothSubstep&, int) {
+        compute_layer1_normals(t, garment.state.x, normals);
         for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
-            if (garment.inv_mass[t.weft_particle[k]] == 0) continue;
-            ASSERT_NEAR(weft_plane_distance(t, normals, garment.x, k), 0, 1e-5) << "layer-2 entry " << k;
+            if (garment.state.inv_mass[t.weft_particle[k]] == 0) continue;
+            ASSERT_NEAR(weft_plane_distance(t, normals, garment.state.x, k), 0, 1e-5) << "layer-2 entry " << k;
             ++checked;
         }
     });
@@ -129,23 +133,25 @@ TEST(Weft, LayerTwoParticlesLieOnTheirPlanesAfterTheConstraintSystem) {
 TEST(Weft, VelocityIsTheNeighboursVelocityProjectedOntoThePlane) {
     const Garment g0 = *make_rectangle(RectangleParams{});
     Garment g = g0;
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     // Give layer 1 a shear-free but non-uniform motion and move layer 1 off the flat sheet.
+    Matrix3X& x = g.state.x;
     for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(t.layer1_count); ++i) {
-        g.v.col(i) = Vec3(Real(0.1) * g.x(0, i), Real(-0.3), Real(0.2) * g.x(1, i));
-        g.x(2, i) += Real(0.05) * std::sin(Real(3) * g.x(0, i));
+        g.state.v.col(i) = Vec3(Real(0.1) * x(0, i), Real(-0.3), Real(0.2) * x(1, i));
+        x(2, i) += Real(0.05) * std::sin(Real(3) * x(0, i));
     }
-    prepare_garment(g);
-    compute_layer1_normals(t, g.x, g.normals);
-    place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, Real(0.01));
+    GarmentSolver s;
+    prepare_solver(g, s);
+    compute_layer1_normals(t, x, s.normals);
+    place_weft(t, s.normals, g.state.inv_mass, x, g.state.v, s.plane_normal, Real(0.01));
     for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
         const std::uint32_t i = t.weft_particle[k];
-        if (g.inv_mass[i] == 0) continue;
-        const Vec3 p = g.plane_normal.col(i);
-        const Vec3 blend = (1 - t.weft_t[k]) * g.v.col(t.weft_left[k]) + t.weft_t[k] * g.v.col(t.weft_right[k]);
+        if (g.state.inv_mass[i] == 0) continue;
+        const Vec3 p = s.plane_normal.col(i);
+        const Vec3 blend = (1 - t.weft_t[k]) * g.state.v.col(t.weft_left[k]) + t.weft_t[k] * g.state.v.col(t.weft_right[k]);
         EXPECT_NEAR(p.norm(), 1, 1e-5);
-        EXPECT_NEAR(g.v.col(i).dot(p), 0, 1e-6);
-        EXPECT_LT((g.v.col(i) - (blend - blend.dot(p) * p)).norm(), 1e-6);
+        EXPECT_NEAR(g.state.v.col(i).dot(p), 0, 1e-6);
+        EXPECT_LT((g.state.v.col(i) - (blend - blend.dot(p) * p)).norm(), 1e-6);
     }
 }
 

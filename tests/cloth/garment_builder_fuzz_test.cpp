@@ -11,7 +11,7 @@
 
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
-#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
@@ -80,13 +80,13 @@ TEST(GarmentBuilderFuzz, RandomRectanglesBuildAndStayFiniteOrGiveOneError) {
         }
         ++built;
         const Garment& g = registry.get<Garment>(*garment);
-        ASSERT_LE(g.x.cols(), max_garment_particles);
-        ASSERT_TRUE(g.x.allFinite());
+        ASSERT_LE(g.state.x.cols(), max_garment_particles);
+        ASSERT_TRUE(g.state.x.allFinite());
         Scheduler scheduler;
         add_cloth_systems(scheduler);
         for (int frame = 0; frame < 3; ++frame) ASSERT_TRUE(scheduler.tick(registry, 1.0 / 60.0));
-        EXPECT_TRUE(g.x.allFinite()) << "case " << i;
-        EXPECT_TRUE(g.v.allFinite()) << "case " << i;
+        EXPECT_TRUE(g.state.x.allFinite()) << "case " << i;
+        EXPECT_TRUE(g.state.v.allFinite()) << "case " << i;
         resets += g.counters.resets;
     }
     RecordProperty("built", built);

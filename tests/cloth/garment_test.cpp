@@ -10,9 +10,10 @@
 #include "components/skinned_mesh.hpp"
 #include "components/transform.hpp"
 #include "systems/cloth/body.hpp"
-#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth_systems.hpp"
 #include "systems/cloth/collision.hpp"
 #include "systems/cloth/garment_builder.hpp"
+#include "systems/cloth/garment_config.hpp"
 #include "systems/cloth/garment_step.hpp"
 #include "systems/cloth/pins.hpp"
 
@@ -25,22 +26,22 @@ TEST(Builders, DefaultSkirtHas837ParticlesIn27WarpLinesOf31) {
     const auto e = attach_skirt(registry, body.character, SkirtParams{});
     ASSERT_TRUE(e) << e.error().message;
     const Garment& g = registry.get<Garment>(*e);
-    EXPECT_EQ(g.x.cols(), 837);
-    EXPECT_EQ(g.topology->warp_lines, 27u);
-    EXPECT_EQ(g.topology->particles_per_line, 31u);
-    EXPECT_EQ(g.topology->layer1_count, 9u * 31u);
-    EXPECT_EQ(g.colliders.size(), 15u);
-    EXPECT_EQ(g.pins.size(), 27u);
-    EXPECT_EQ(g.topology->triangles.size(), 27u * 30u * 6u);
+    EXPECT_EQ(g.state.x.cols(), 837);
+    EXPECT_EQ(g.fabric->warp_lines, 27u);
+    EXPECT_EQ(g.fabric->particles_per_line, 31u);
+    EXPECT_EQ(g.fabric->layer1_count, 9u * 31u);
+    EXPECT_EQ(g.body.colliders.size(), 15u);
+    EXPECT_EQ(g.state.pins.size(), 27u);
+    EXPECT_EQ(g.fabric->triangles.size(), 27u * 30u * 6u);
     // Placed around the hips: the waist ring is near the pelvis, the hem lower.
     const auto& pelvis = registry.get<EllipsoidCollider>(body.colliders[0]);
-    for (const PinBinding& pin : g.pins) {
+    for (const PinBinding& pin : g.state.pins) {
         EXPECT_EQ(pin.kind, PinKind::collider);
-        EXPECT_LT(std::abs(g.x(1, pin.particle) - pelvis.world.translation().y()), 0.2f);
+        EXPECT_LT(std::abs(g.state.x(1, pin.particle) - pelvis.world.translation().y()), 0.2f);
     }
-    for (Eigen::Index p = 0; p < g.x.cols(); ++p)
-        for (Entity c : g.colliders)
-            EXPECT_LE(penetration_depth(make_ellipsoid_frame(registry.get<EllipsoidCollider>(c).world), g.x.col(p)), 1e-5);
+    for (Eigen::Index p = 0; p < g.state.x.cols(); ++p)
+        for (Entity c : g.body.colliders)
+            EXPECT_LE(penetration_depth(make_ellipsoid_frame(registry.get<EllipsoidCollider>(c).world), g.state.x.col(p)), 1e-5);
 }
 
 TEST(Builders, DressScalesPastTenThousandParticles) {
@@ -49,10 +50,10 @@ TEST(Builders, DressScalesPastTenThousandParticles) {
     const auto e = attach_dress(registry, body.character, DressParams{});
     ASSERT_TRUE(e) << e.error().message;
     const Garment& g = registry.get<Garment>(*e);
-    EXPECT_GE(g.x.cols(), 10000);
+    EXPECT_GE(g.state.x.cols(), 10000);
     // Hangs from the shoulders: the pinned ring is above the chest centre's bottom.
     const Real chest_y = registry.get<EllipsoidCollider>(body.colliders[2]).world.translation().y();
-    for (const PinBinding& pin : g.pins) EXPECT_GT(g.x(1, pin.particle), chest_y - 0.2f);
+    for (const PinBinding& pin : g.state.pins) EXPECT_GT(g.state.x(1, pin.particle), chest_y - 0.2f);
 }
 
 TEST(Builders, ParameterErrorsNameTheField) {
@@ -102,10 +103,10 @@ TEST(Pins, FollowTheirBindingExactlyAtTheEndOfEveryStep) {
     for (int frame = 0; frame < 90; ++frame) {
         scene.run(1);
         const Garment& g = scene.registry.get<Garment>(e);
-        for (const PinBinding& pin : g.pins) {
+        for (const PinBinding& pin : g.state.pins) {
             const auto expected = evaluate_pin(scene.registry, g, pin);
             ASSERT_TRUE(expected);
-            ASSERT_LE((g.x.col(pin.particle) - *expected).norm(), 1e-6) << "pin " << pin.particle;
+            ASSERT_LE((g.state.x.col(pin.particle) - *expected).norm(), 1e-6) << "pin " << pin.particle;
         }
     }
 }
@@ -159,7 +160,7 @@ TEST(Pins, SkinnedPinsFollowLinearBlendSkinningOfTheSkin) {
     const auto e = attach_skirt(registry, character, params);
     ASSERT_TRUE(e) << e.error().message;
     Garment& g = registry.get<Garment>(*e);
-    for (const PinBinding& pin : g.pins) ASSERT_EQ(pin.kind, PinKind::skinned);
+    for (const PinBinding& pin : g.state.pins) ASSERT_EQ(pin.kind, PinKind::skinned);
 
     // Move the bones and the character; every pin must be where LBS puts it.
     auto& s = registry.get<Skeleton>(character);
@@ -170,9 +171,9 @@ TEST(Pins, SkinnedPinsFollowLinearBlendSkinningOfTheSkin) {
     add_cloth_systems(scheduler);
     ASSERT_TRUE(scheduler.tick(registry, 1.0 / 60.0));
     const Affine3 world = registry.get<Transform>(character).matrix();
-    for (const PinBinding& pin : g.pins) {
+    for (const PinBinding& pin : g.state.pins) {
         const Vec3 expected = world * (blend_skinning(s.skinning, pin.bones, pin.weights) * pin.local);
-        ASSERT_LE((g.x.col(pin.particle) - expected).norm(), 1e-6);
+        ASSERT_LE((g.state.x.col(pin.particle) - expected).norm(), 1e-6);
         // The binding uses the weights of a skin vertex.
         bool matches = false;
         for (int i = 0; i < ring; ++i)
@@ -188,29 +189,49 @@ TEST(Substeps, RuleFollowsStabilityAndColliderSpeed) {
     test::AnalyticBody body(registry, still);
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     const ClothSolverSettings settings;
-    EXPECT_EQ(garment_substeps(registry, g, 1.0 / 60.0, settings), 1);  // default skirt: one substep
-    g.model = ClothModel::classic;
-    EXPECT_GE(garment_substeps(registry, g, 1.0 / 60.0, settings), 2);  // same material, more springs
-    g.model = ClothModel::simplified;
-    g.material.stretch_k_N_m *= 16;                                      // 4x the stability need
-    EXPECT_EQ(garment_substeps(registry, g, 1.0 / 60.0, settings), 4);
-    g.material.stretch_k_N_m /= 16;
+    EXPECT_EQ(garment_substeps(registry, g, solver, 1.0 / 60.0, settings), 1);  // default skirt: one substep
+    ASSERT_TRUE(set_garment_model(registry, e, ClothModel::classic));
+    EXPECT_GE(garment_substeps(registry, g, solver, 1.0 / 60.0, settings), 2);  // same material, more springs
+    ASSERT_TRUE(set_garment_model(registry, e, ClothModel::simplified));
+    ClothMaterial stiff = g.config.material;
+    stiff.stretch_k_N_m *= 16;                                                   // 4x the stability need
+    ASSERT_TRUE(set_garment_material(registry, e, stiff));
+    EXPECT_EQ(garment_substeps(registry, g, solver, 1.0 / 60.0, settings), 4);
+    stiff.stretch_k_N_m /= 16;
+    ASSERT_TRUE(set_garment_material(registry, e, stiff));
     // A thigh swinging at 6 m/s relative to the pelvis: 0.1 m per step / 0.04 m -> 3 substeps.
     registry.get<EllipsoidCollider>(body.colliders[7]).velocity_m_s = Vec3(0, 0, 6);
-    g.lists_valid = false;
-    EXPECT_EQ(garment_substeps(registry, g, 1.0 / 60.0, settings), 3);
+    invalidate(solver);
+    EXPECT_EQ(garment_substeps(registry, g, solver, 1.0 / 60.0, settings), 3);
     EXPECT_EQ(g.counters.substeps_motion, 3);
     // Capped.
     registry.get<EllipsoidCollider>(body.colliders[7]).velocity_m_s = Vec3(0, 0, 600);
-    EXPECT_EQ(cloth_substeps(registry, 1.0 / 60.0, settings), settings.max_substeps);
+    EXPECT_EQ(garment_substeps(registry, g, solver, 1.0 / 60.0, settings), settings.max_substeps);
+    // Fixed.
+    ClothSolverSettings fixed = settings;
+    fixed.fixed_substeps = 5;
+    EXPECT_EQ(garment_substeps(registry, g, solver, 1.0 / 60.0, fixed), 5);
 }
 
-TEST(Systems, ThreeClothSystemsRunInOrderInTheSimulationPhase) {
-    Scheduler scheduler;
-    add_cloth_systems(scheduler);
-    EXPECT_EQ(scheduler.system_names(Phase::simulation),
-              (std::vector<std::string>{"cloth_integration", "cloth_constraint", "cloth_collision"}));
+TEST(Systems, TheClothStepRunsItsThreeSystemsInOrderInEverySubstep) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, SkirtParams{});
+    EXPECT_EQ(scene.scheduler.system_names(Phase::simulation), (std::vector<std::string>{"cloth"}));
+    std::vector<std::string> sections;
+    for (const SystemStats& s : scene.scheduler.profiler().stats())
+        if (s.parent == "cloth") sections.push_back(s.name);
+    EXPECT_EQ(sections, (std::vector<std::string>{"cloth_integration", "cloth_constraint", "cloth_collision"}));
+    scene.run(20);
+    const FrameProfiler& profiler = scene.scheduler.profiler();
+    const std::uint64_t steps = profiler.stats("cloth").runs;
+    EXPECT_EQ(steps, 20u);
+    const std::uint64_t substeps = profiler.stats("cloth_integration").runs;
+    EXPECT_GE(substeps, steps);
+    EXPECT_EQ(profiler.stats("cloth_constraint").runs, substeps);
+    EXPECT_EQ(profiler.stats("cloth_collision").runs, substeps);
+    EXPECT_EQ(scene.registry.get<Garment>(e).counters.steps, steps);
 }
 
 TEST(Robustness, NonFiniteValuesAreDetectedReportedAndTheGarmentReset) {
@@ -218,18 +239,18 @@ TEST(Robustness, NonFiniteValuesAreDetectedReportedAndTheGarmentReset) {
     const Entity e = *attach_skirt(scene.registry, scene.body.character, SkirtParams{});
     scene.run(20);
     Garment& g = scene.registry.get<Garment>(e);
-    g.x(1, 500) = std::numeric_limits<Real>::quiet_NaN();
-    g.v(0, 400) = std::numeric_limits<Real>::infinity();
+    g.state.x(1, 500) = std::numeric_limits<Real>::quiet_NaN();
+    g.state.v(0, 400) = std::numeric_limits<Real>::infinity();
     testing::internal::CaptureStderr();
     scene.run(1);
     const std::string report = testing::internal::GetCapturedStderr();
     EXPECT_NE(report.find("non-finite"), std::string::npos);
     EXPECT_GE(g.counters.non_finite_values, 1u);
     EXPECT_EQ(g.counters.resets, 1u);
-    EXPECT_TRUE(g.x.allFinite());
-    EXPECT_TRUE(g.v.allFinite());
+    EXPECT_TRUE(g.state.x.allFinite());
+    EXPECT_TRUE(g.state.v.allFinite());
     scene.run(30);
-    EXPECT_TRUE(g.x.allFinite());
+    EXPECT_TRUE(g.state.x.allFinite());
     EXPECT_EQ(g.counters.resets, 1u);
 }
 
@@ -241,13 +262,13 @@ TEST(Robustness, ResetPutsTheGarmentBackAtRestAroundTheBodyWhereItIsNow) {
     reset_garment(scene.registry, e);
     const auto& pelvis = scene.registry.get<EllipsoidCollider>(scene.body.colliders[0]);
     const Vec3 centre = pelvis.world.translation();
-    for (Eigen::Index p = 0; p < g.x.cols(); ++p) {
-        const Vec3 d = g.x.col(p) - centre;
+    for (Eigen::Index p = 0; p < g.state.x.cols(); ++p) {
+        const Vec3 d = g.state.x.col(p) - centre;
         ASSERT_LT(Vec3(d.x(), 0, d.z()).norm(), 0.6f);
         ASSERT_LT(std::abs(d.y()), 0.8f);
     }
-    for (const PinBinding& pin : g.pins)
-        EXPECT_LE((g.x.col(pin.particle) - *evaluate_pin(scene.registry, g, pin)).norm(), 1e-6);
+    for (const PinBinding& pin : g.state.pins)
+        EXPECT_LE((g.state.x.col(pin.particle) - *evaluate_pin(scene.registry, g, pin)).norm(), 1e-6);
     EXPECT_EQ(g.counters.resets, 1u);
 }
 
@@ -272,7 +293,7 @@ Matrix3X simulate_crowd(int threads, int avatars, int frames) {
     for (int f = 0; f < frames; ++f) (void)scheduler.tick(registry, 1.0 / 60.0);
     Matrix3X all(3, 0);
     for (Entity e : garments) {
-        const Matrix3X& x = registry.get<Garment>(e).x;
+        const Matrix3X& x = registry.get<Garment>(e).state.x;
         Matrix3X joined(3, all.cols() + x.cols());
         joined << all, x;
         all = joined;

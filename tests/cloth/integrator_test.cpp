@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "systems/cloth/cloth_systems.hpp"
+#include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
 #include "systems/cloth/integrator.hpp"
 
@@ -42,17 +42,17 @@ TEST(FreeFall, WholeSheetFallsRigidlyThroughTheThreeSystems) {
         const Entity e = *attach_rectangle(registry, params);
         Scheduler scheduler;
         add_cloth_systems(scheduler);
-        const Matrix3X x0 = registry.get<Garment>(e).x;
+        const Matrix3X x0 = registry.get<Garment>(e).state.x;
         const int frames = 30;
         for (int i = 0; i < frames; ++i) ASSERT_TRUE(scheduler.tick(registry, 1.0 / 60.0));
         const Garment& g = registry.get<Garment>(e);
         const int n = frames * g.counters.substeps;
         const double h = 1.0 / 60.0 / g.counters.substeps;
         const double drop = double(standard_gravity_m_s2) * h * h * n * (n + 1) / 2;
-        for (Eigen::Index p = 0; p < g.x.cols(); ++p) {
-            ASSERT_NEAR(g.x(0, p), x0(0, p), 1e-5);
-            ASSERT_NEAR(g.x(1, p), x0(1, p) - drop, 1e-4) << "particle " << p;
-            ASSERT_NEAR(g.x(2, p), x0(2, p), 1e-5);
+        for (Eigen::Index p = 0; p < g.state.x.cols(); ++p) {
+            ASSERT_NEAR(g.state.x(0, p), x0(0, p), 1e-5);
+            ASSERT_NEAR(g.state.x(1, p), x0(1, p) - drop, 1e-4) << "particle " << p;
+            ASSERT_NEAR(g.state.x(2, p), x0(2, p), 1e-5);
         }
     }
 }
@@ -104,11 +104,11 @@ TEST(SingleSpring, OscillatesAsTheSchemesDiscreteSolutionAndNearTheAnalyticFrequ
 TEST(Stability, ClassicNeedsASmallerStepThanSimplifiedForTheSameMaterial) {
     RectangleParams params;
     const Garment g = *make_rectangle(params);
-    const Real simplified = stable_step_s(*g.topology, g.material, g.inv_mass, ClothModel::simplified);
-    const Real classic = stable_step_s(*g.topology, g.material, g.inv_mass, ClothModel::classic);
+    const Real simplified = stable_step_s(*g.fabric, g.config.material, g.state.inv_mass, ClothModel::simplified);
+    const Real classic = stable_step_s(*g.fabric, g.config.material, g.state.inv_mass, ClothModel::classic);
     EXPECT_GT(simplified, classic);
     // A single spring and a fixed end: the bound is the textbook 2 sqrt(m / k).
-    GarmentTopology t;
+    Fabric t;
     t.layer = {1, 1};
     t.layer1_count = 2;
     t.warp1.add(0, 1, 1);

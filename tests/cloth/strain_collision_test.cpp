@@ -66,26 +66,27 @@ TEST(StrainCollision, WalkingSkirtPushOutsStayShorterThanTheLargestRadius) {
     test::AnalyticBody body(registry);
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
-    const GarmentTopology& t = *g.topology;
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
+    const Fabric& t = *g.fabric;
     Real farthest = 0, worst_strain = 0;
     Matrix3X before;
     test::step_by_hand(
-        body, registry, g, 132,  // two walk cycles
-        [&](Garment& garment, const FrameContext&, int) { before = garment.x; },
-        [&](Garment& garment, const FrameContext& ctx, int frame) {
-            collide_garment_step(registry, garment, ctx);
+        body, registry, g, solver, 132,  // two walk cycles
+        [&](Garment& garment, GarmentSolver&, const ClothSubstep&, int) { before = garment.state.x; },
+        [&](Garment& garment, GarmentSolver& solver, const ClothSubstep& ctx, int frame) {
+            collide_garment_step(registry, garment, solver, ctx);
             ASSERT_EQ(garment.counters.resets, 0u);
             Real largest_radius = 0;
-            for (const EllipsoidFrame& f : garment.frames) largest_radius = std::max(largest_radius, f.radii_m.maxCoeff());
-            for (Eigen::Index p = 0; p < garment.x.cols(); ++p) {
-                const Real move = (garment.x.col(p) - before.col(p)).norm();
+            for (const EllipsoidFrame& f : solver.frames) largest_radius = std::max(largest_radius, f.radii_m.maxCoeff());
+            for (Eigen::Index p = 0; p < garment.state.x.cols(); ++p) {
+                const Real move = (garment.state.x.col(p) - before.col(p)).norm();
                 farthest = std::max(farthest, move);
                 ASSERT_LE(move, largest_radius) << "particle " << p << " frame " << frame;
             }
             for (const SpringPhase* phase : {&t.warp1, &t.warp2, &t.weft})
                 for (std::size_t k = 0; k < phase->size(); ++k)
                     worst_strain = std::max(
-                        worst_strain, (garment.x.col(phase->b[k]) - garment.x.col(phase->a[k])).norm() / phase->rest_m[k] - 1);
+                        worst_strain, (garment.state.x.col(phase->b[k]) - garment.state.x.col(phase->a[k])).norm() / phase->rest_m[k] - 1);
         });
     RecordProperty("farthest_push_out_m", std::to_string(farthest));
     RecordProperty("worst_strain_after_collision", std::to_string(worst_strain));

@@ -34,11 +34,11 @@ struct Checked {
 // `below_pins`: also the warp springs hanging from a pinned particle (false for the placement
 // alone, without the chord lift before it).
 void expect_layer2_bounds(const Garment& g, Real limit, Checked& checked, bool below_pins = true) {
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     const Real stretch = 1 + limit;
     for (std::size_t s = 0; s < t.warp2.size(); ++s) {
-        if (g.inv_mass[t.warp2.a[s]] == 0 && (!below_pins || g.inv_mass[t.warp2.b[s]] == 0)) continue;
-        const Real length = (g.x.col(t.warp2.b[s]) - g.x.col(t.warp2.a[s])).norm();
+        if (g.state.inv_mass[t.warp2.a[s]] == 0 && (!below_pins || g.state.inv_mass[t.warp2.b[s]] == 0)) continue;
+        const Real length = (g.state.x.col(t.warp2.b[s]) - g.state.x.col(t.warp2.a[s])).norm();
         ASSERT_LE(length, stretch * t.warp2.rest_m[s] * tolerance + slack_m) << "layer-2 warp spring " << s;
         ++checked.warp;
     }
@@ -51,10 +51,10 @@ void expect_layer2_bounds(const Garment& g, Real limit, Checked& checked, bool b
             if (entry[end] != none) k = entry[end];
         if (k == none) continue;  // layer 1 to layer 1 (stride 1)
         const std::uint32_t i = t.weft_particle[k], above = t.weft_above[k];
-        if (g.inv_mass[i] == 0 || (above != none && g.inv_mass[above] == 0)) continue;
-        const Real chord = (g.x.col(t.weft_right[k]) - g.x.col(t.weft_left[k])).norm();
+        if (g.state.inv_mass[i] == 0 || (above != none && g.state.inv_mass[above] == 0)) continue;
+        const Real chord = (g.state.x.col(t.weft_right[k]) - g.state.x.col(t.weft_left[k])).norm();
         const Real bound = std::max(stretch * t.weft_rest_m[k], chord / Real(t.weft_stride));
-        const Real length = (g.x.col(t.weft.b[s]) - g.x.col(t.weft.a[s])).norm();
+        const Real length = (g.state.x.col(t.weft.b[s]) - g.state.x.col(t.weft.a[s])).norm();
         ASSERT_LE(length, bound * tolerance + slack_m) << "weft segment " << s;
         ++checked.weft;
     }
@@ -65,9 +65,10 @@ TEST(StrainLayer2, WalkingSkirtHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem
     test::AnalyticBody body(registry);
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     Checked checked;
-    test::step_by_hand(body, registry, g, 150, [&](Garment& garment, const FrameContext&, int) {
-        expect_layer2_bounds(garment, garment.material.strain_limit, checked);
+    test::step_by_hand(body, registry, g, solver, 150, [&](Garment& garment, GarmentSolver&, const ClothSubstep&, int) {
+        expect_layer2_bounds(garment, garment.config.material.strain_limit, checked);
     });
     EXPECT_GT(checked.warp, 50000u);
     EXPECT_GT(checked.weft, 100000u);
@@ -78,9 +79,10 @@ TEST(StrainLayer2, WalkingDressHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem
     test::AnalyticBody body(registry);
     const Entity e = *attach_dress(registry, body.character, DressParams{});
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     Checked checked;
-    test::step_by_hand(body, registry, g, 40, [&](Garment& garment, const FrameContext&, int) {
-        expect_layer2_bounds(garment, garment.material.strain_limit, checked);
+    test::step_by_hand(body, registry, g, solver, 40, [&](Garment& garment, GarmentSolver&, const ClothSubstep&, int) {
+        expect_layer2_bounds(garment, garment.config.material.strain_limit, checked);
     });
     EXPECT_GT(checked.warp, 200000u);
 }
@@ -97,31 +99,32 @@ TEST(StrainLayer2, RowsAboveGoBackOntoTheirChordsWhereNoBulgeHoldsTheWarpSpring)
     params.width_m = Real(0.3);
     params.length_m = Real(0.3);
     Garment g = *make_rectangle(params);
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     const Vec3 origin = params.origin;
     const Real drop = Real(0.1099);
     for (std::uint32_t line = 0; line < 4; ++line)
         for (std::uint32_t row = 0; row < 4; ++row) {
             const std::uint32_t i = t.grid[line * 4 + row];
-            g.x.col(i) = origin + Vec3(Real(0.1) * Real(line), -drop * Real(row), 0);
-            if (row == 0 && t.layer[i] == 2) g.x(2, i) += Real(0.05);          // pinned, off its chord
-            if (row > 0 && t.layer[i] == 2) g.x(2, i) += Real(0.04);           // wants to follow
+            g.state.x.col(i) = origin + Vec3(Real(0.1) * Real(line), -drop * Real(row), 0);
+            if (row == 0 && t.layer[i] == 2) g.state.x(2, i) += Real(0.05);          // pinned, off its chord
+            if (row > 0 && t.layer[i] == 2) g.state.x(2, i) += Real(0.04);           // wants to follow
         }
-    g.v.setZero();
-    prepare_garment(g);
-    compute_layer1_normals(t, g.x, g.normals);
-    place_weft(t, g.normals, g.inv_mass, g.x, g.v, g.plane_normal, Real(0.01), Real(0.10));
+    g.state.v.setZero();
+    GarmentSolver solver;
+    prepare_solver(g, solver);
+    compute_layer1_normals(t, g.state.x, solver.normals);
+    place_weft(t, solver.normals, g.state.inv_mass, g.state.x, g.state.v, solver.plane_normal, Real(0.01), Real(0.10));
 
     Checked checked;
     expect_layer2_bounds(g, Real(0.10), checked, false);
     EXPECT_EQ(checked.warp, 4u);  // rows 1 -> 2 and 2 -> 3 on both layer-2 lines
     for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
         const std::uint32_t i = t.weft_particle[k];
-        if (g.inv_mass[i] == 0) continue;
-        EXPECT_NEAR(weft_plane_distance(t, g.normals, g.x, k), 0, 1e-6) << "entry " << k;
+        if (g.state.inv_mass[i] == 0) continue;
+        EXPECT_NEAR(weft_plane_distance(t, solver.normals, g.state.x, k), 0, 1e-6) << "entry " << k;
         if (k % 4 == 1) {  // row 1: back on its chord
-            const Vec3 chord = (1 - t.weft_t[k]) * g.x.col(t.weft_left[k]) + t.weft_t[k] * g.x.col(t.weft_right[k]);
-            EXPECT_LT((g.x.col(i) - chord).norm(), 1e-6) << "entry " << k;
+            const Vec3 chord = (1 - t.weft_t[k]) * g.state.x.col(t.weft_left[k]) + t.weft_t[k] * g.state.x.col(t.weft_right[k]);
+            EXPECT_LT((g.state.x.col(i) - chord).norm(), 1e-6) << "entry " << k;
         }
     }
 }
@@ -138,34 +141,35 @@ TEST(StrainLayer2, ChordsBelowThePinsAreLiftedWithinTheLimitOfThePinnedParticles
     params.width_m = Real(0.3);
     params.length_m = Real(0.3);
     Garment g = *make_rectangle(params);
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     for (std::uint32_t line = 0; line < 4; ++line)
         for (std::uint32_t row = 0; row < 4; ++row) {
             const std::uint32_t i = t.grid[line * 4 + row];
-            g.x.col(i) = params.origin + Vec3(Real(0.1) * Real(line), Real(-0.1099) * Real(row), 0);
-            if (row == 0 && t.layer[i] == 2) g.x(2, i) += Real(0.05);  // pinned, off its chord
+            g.state.x.col(i) = params.origin + Vec3(Real(0.1) * Real(line), Real(-0.1099) * Real(row), 0);
+            if (row == 0 && t.layer[i] == 2) g.state.x(2, i) += Real(0.05);  // pinned, off its chord
         }
-    g.v.setZero();
-    prepare_garment(g);
-    const Matrix3X before = g.x;
-    EXPECT_TRUE(lift_chords_below_pins(t, g.inv_mass, g.x, g.v, g.force, Real(0.01), Real(0.10)));
+    g.state.v.setZero();
+    GarmentSolver solver;
+    prepare_solver(g, solver);
+    const Matrix3X before = g.state.x;
+    EXPECT_TRUE(lift_chords_below_pins(t, g.state.inv_mass, g.state.x, g.state.v, solver.force, Real(0.01), Real(0.10)));
     for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
         if (k % 4 != 1) continue;  // row 1 hangs from the pinned row 0
-        const Vec3 chord = (1 - t.weft_t[k]) * g.x.col(t.weft_left[k]) + t.weft_t[k] * g.x.col(t.weft_right[k]);
-        EXPECT_LE((chord - g.x.col(t.weft_above[k])).norm(), Real(1.10) * t.weft_above_rest_m[k] * tolerance) << "entry " << k;
+        const Vec3 chord = (1 - t.weft_t[k]) * g.state.x.col(t.weft_left[k]) + t.weft_t[k] * g.state.x.col(t.weft_right[k]);
+        EXPECT_LE((chord - g.state.x.col(t.weft_above[k])).norm(), Real(1.10) * t.weft_above_rest_m[k] * tolerance) << "entry " << k;
     }
     for (std::size_t s = 0; s < t.warp1.size(); ++s) {
-        const Real length = (g.x.col(t.warp1.b[s]) - g.x.col(t.warp1.a[s])).norm();
-        if (g.inv_mass[t.warp1.a[s]] == 0) {
+        const Real length = (g.state.x.col(t.warp1.b[s]) - g.state.x.col(t.warp1.a[s])).norm();
+        if (g.state.inv_mass[t.warp1.a[s]] == 0) {
             EXPECT_LE(length, Real(1.10) * t.warp1.rest_m[s] * tolerance) << "spring " << s;
         }
     }
     // Only the layer-1 particles of row 1 moved, and their velocities followed (h = 0.01 s).
-    for (Eigen::Index i = 0; i < g.x.cols(); ++i) {
-        const Vec3 move = g.x.col(i) - before.col(i);
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i) {
+        const Vec3 move = g.state.x.col(i) - before.col(i);
         const bool row1_layer1 = t.layer[static_cast<std::size_t>(i)] == 1 && (t.grid[1] == i || t.grid[3 * 4 + 1] == i);
         if (!row1_layer1) EXPECT_EQ(move.norm(), 0) << "particle " << i;
-        else EXPECT_LT((g.v.col(i) - move / Real(0.01)).norm(), 1e-3) << "particle " << i;
+        else EXPECT_LT((g.state.v.col(i) - move / Real(0.01)).norm(), 1e-3) << "particle " << i;
     }
 }
 
@@ -184,33 +188,32 @@ TEST(StrainLayer2, EveryWarpSpringBelowACurvedPinnedRowIsWithinTheLimitAfterTheC
     params.width_m = Real(0.6);
     params.length_m = Real(0.4);
     Garment g = *make_rectangle(params);
-    const GarmentTopology& t = *g.topology;
+    const Fabric& t = *g.fabric;
     const Real offset = Real(0.15);
     for (std::uint32_t line = 0; line < 7; ++line)
         for (std::uint32_t row = 0; row < 5; ++row) {
             const std::uint32_t i = t.grid[line * 5 + row];
-            g.x.col(i) = params.origin + Vec3(Real(0.1) * Real(line), Real(-0.1099) * Real(row), 0);
-            if (row == 0 && t.layer[i] == 2) g.x(2, i) += line < 3 ? offset : -offset;
+            g.state.x.col(i) = params.origin + Vec3(Real(0.1) * Real(line), Real(-0.1099) * Real(row), 0);
+            if (row == 0 && t.layer[i] == 2) g.state.x(2, i) += line < 3 ? offset : -offset;
         }
-    g.v.setZero();
-    FrameContext ctx;
-    ctx.fixed_dt_s = ctx.h_s = 1.0 / 60.0;
-    constrain_garment(g, ctx);
+    g.state.v.setZero();
+    GarmentSolver solver;
+    constrain_garment(g, solver, make_substep(0, 1, 1.0 / 60.0));
 
     std::size_t below_pins = 0;
     for (const SpringPhase* warp : {&t.warp1, &t.warp2})
         for (std::size_t s = 0; s < warp->size(); ++s) {
-            const bool pinned_a = g.inv_mass[warp->a[s]] == 0;
-            if (pinned_a && g.inv_mass[warp->b[s]] == 0) continue;
-            const Real length = (g.x.col(warp->b[s]) - g.x.col(warp->a[s])).norm();
+            const bool pinned_a = g.state.inv_mass[warp->a[s]] == 0;
+            if (pinned_a && g.state.inv_mass[warp->b[s]] == 0) continue;
+            const Real length = (g.state.x.col(warp->b[s]) - g.state.x.col(warp->a[s])).norm();
             EXPECT_LE(length, Real(1.10) * warp->rest_m[s] * tolerance + slack_m) << "warp spring " << s;
             below_pins += pinned_a ? 1 : 0;
         }
     EXPECT_EQ(below_pins, 7u);  // every line's first spring
-    compute_layer1_normals(t, g.x, g.normals);
+    compute_layer1_normals(t, g.state.x, solver.normals);
     for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
-        if (g.inv_mass[t.weft_particle[k]] == 0) continue;
-        EXPECT_NEAR(weft_plane_distance(t, g.normals, g.x, k), 0, 1e-6) << "entry " << k;
+        if (g.state.inv_mass[t.weft_particle[k]] == 0) continue;
+        EXPECT_NEAR(weft_plane_distance(t, solver.normals, g.state.x, k), 0, 1e-6) << "entry " << k;
     }
 }
 

@@ -14,18 +14,19 @@ TEST(StrainRest, SkirtOnAStillBodyComesToRest) {
     test::AnalyticBody body(registry);
     const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
     Garment& g = registry.get<Garment>(e);
+    GarmentSolver& solver = registry.get<GarmentSolver>(e);
     double mean_speed = 0;
     const int frames = 600, measured = 60;
     test::step_by_hand(
-        body, registry, g, frames, [](Garment&, const FrameContext&, int) {},
-        [&](Garment& garment, const FrameContext& ctx, int frame) {
-            collide_garment_step(registry, garment, ctx);
-            if (ctx.substep + 1 < ctx.substeps || frame < frames - measured) return;
+        body, registry, g, solver, frames, test::StageCheck{},
+        [&](Garment& garment, GarmentSolver& solver, const ClothSubstep& ctx, int frame) {
+            collide_garment_step(registry, garment, solver, ctx);
+            if (!ctx.last() || frame < frames - measured) return;
             double sum = 0;
             int free = 0;
-            for (Eigen::Index p = 0; p < garment.x.cols(); ++p)
-                if (garment.inv_mass[p] > 0) {
-                    sum += garment.v.col(p).norm();
+            for (Eigen::Index p = 0; p < garment.state.x.cols(); ++p)
+                if (garment.state.inv_mass[p] > 0) {
+                    sum += garment.state.v.col(p).norm();
                     ++free;
                 }
             mean_speed += sum / free / measured;

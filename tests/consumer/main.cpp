@@ -14,7 +14,7 @@ int main() {
     registry.emplace<Spin>(registry.create());
     scheduler.add({"spin", drape::Phase::simulation, {}, drape::components<Spin>(), {},
                    [](drape::Registry& r, const drape::FrameContext& c) {
-                       r.view<Spin>().each([&](drape::Entity, Spin& s) { s.angle += float(c.h_s); });
+                       r.view<Spin>().each([&](drape::Entity, Spin& s) { s.angle += float(c.fixed_dt_s); });
                    }});
     auto report = scheduler.tick(registry, 1.0 / 60.0);
     if (!report || report->steps != 1) return 1;

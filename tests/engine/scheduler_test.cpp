@@ -87,7 +87,7 @@ TEST(FixedStep, HitchIsCappedAndTheExcessDropped) {
     std::vector<double> step_sizes;
     Scheduler s(SchedulerSettings{.fixed_dt_s = 1.0 / 60.0, .max_steps_per_frame = 4, .time_scale = 1});
     s.add({"sim", Phase::simulation, {}, components<Body>(), {},
-           [&](Registry&, const FrameContext& c) { step_sizes.push_back(c.h_s); }});
+           [&](Registry&, const FrameContext& c) { step_sizes.push_back(c.fixed_dt_s); }});
     auto report = s.tick(r, 0.5);  // a half-second hitch
     ASSERT_TRUE(report);
     EXPECT_EQ(report->steps, 4);  // not 30: the game does not freeze
@@ -115,20 +115,35 @@ TEST(FixedStep, BadFrameTimesAreRejectedAndNothingRuns) {
     EXPECT_EQ(s.frame(), 0u);
 }
 
-TEST(FixedStep, SubstepRuleSplitsTheSimulationStep) {
+TEST(FixedStep, ASystemTimesSectionsOfItsOwnUnderItsName) {
+    // A solver that substeps owns its loop: the scheduler runs it once per fixed step, and
+    // it times each section through the context's profiler, in slots listed under it.
     Registry r;
-    r.emplace<Body>(r.create());
-    std::vector<int> substeps;
-    double simulated = 0;
+    const Entity body = r.create();
+    r.emplace<Body>(body);
     Scheduler s;
-    s.set_substep_rule([](Registry&, double) { return 3; });
-    s.add({"sim", Phase::simulation, {}, components<Body>(), {}, [&](Registry&, const FrameContext& c) {
-               substeps.push_back(c.substep);
-               simulated += c.h_s;
-           }});
+    std::uint32_t section = 0;
+    int sections_run = 0;
+    const std::uint32_t own = s.add({"solver", Phase::simulation, {}, components<Body>(), {},
+                                     [&](Registry&, const FrameContext& c) {
+                                         ASSERT_NE(c.profiler, nullptr);
+                                         for (int k = 0; k < 3; ++k) {
+                                             ProfileScope scope(*c.profiler, section);
+                                             ++sections_run;
+                                         }
+                                     }});
+    section = s.profiler().add_slot("solver_part", own);
+    ASSERT_TRUE(s.tick(r, 2.0 / 60.0));
+    EXPECT_EQ(sections_run, 6);
+    EXPECT_EQ(s.profiler().stats("solver").runs, 2u);
+    EXPECT_EQ(s.profiler().stats("solver_part").runs, 6u);
+    EXPECT_EQ(s.profiler().stats("solver_part").parent, "solver");
+    EXPECT_NE(s.profiler().table().find("  solver_part"), std::string::npos);
+    // Skipped with its system.
+    r.remove<Body>(body);
     ASSERT_TRUE(s.tick(r, 1.0 / 60.0));
-    EXPECT_EQ(substeps, (std::vector<int>{0, 1, 2}));
-    EXPECT_NEAR(simulated, 1.0 / 60.0, 1e-12);
+    EXPECT_EQ(s.profiler().stats("solver").skips, 1u);
+    EXPECT_EQ(s.profiler().stats("solver_part").skips, 1u);
 }
 
 TEST(FixedStep, TimeScaleSlowsOrStopsSimulation) {

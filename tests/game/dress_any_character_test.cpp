@@ -29,11 +29,11 @@ const Character characters[] = {
 // Free particles inside an ellipsoid of the garment's body (1 % inside the surface).
 int particles_inside(World& world, const Garment& g) {
     int inside = 0;
-    for (Eigen::Index i = 0; i < g.x.cols(); ++i) {
-        if (g.inv_mass[i] == 0) continue;  // pinned to the skin
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i) {
+        if (g.state.inv_mass[i] == 0) continue;  // pinned to the skin
         bool in = false;
         world.registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
-            if (c.character == g.body && (c.world.inverse() * g.x.col(i)).norm() < 0.99f) in = true;
+            if (c.character == g.body.character && (c.world.inverse() * g.state.x.col(i)).norm() < 0.99f) in = true;
         });
         inside += in ? 1 : 0;
     }
@@ -58,16 +58,16 @@ void dress_and_walk(const Character& c, GarmentType type) {
     const Garment& g = world->registry.get<Garment>(world->garments[0]);
     EXPECT_EQ(particles_inside(*world, g), 0);
     // On the body: the garment's centre is near its anchor ellipsoid (hips or chest) horizontally.
-    ASSERT_GE(g.anchor, 0);
-    const Vec3 anchor = world->registry.get<EllipsoidCollider>(g.colliders.at(static_cast<std::size_t>(g.anchor))).world.translation();
-    const Vec3 centre = g.x.rowwise().mean();
+    ASSERT_GE(g.body.anchor, 0);
+    const Vec3 anchor = world->registry.get<EllipsoidCollider>(g.body.colliders.at(static_cast<std::size_t>(g.body.anchor))).world.translation();
+    const Vec3 centre = g.state.x.rowwise().mean();
     EXPECT_LT(Vec3(centre.x() - anchor.x(), 0, centre.z() - anchor.z()).norm(), 0.25f);
     // Hanging from its fitting ring: the garment's centre is below its pinned particles.
     Vec3 ring = Vec3::Zero();
     int pinned = 0;
-    for (Eigen::Index i = 0; i < g.x.cols(); ++i)
-        if (g.inv_mass[i] == 0) {
-            ring += g.x.col(i);
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i)
+        if (g.state.inv_mass[i] == 0) {
+            ring += g.state.x.col(i);
             ++pinned;
         }
     ASSERT_GT(pinned, 0);

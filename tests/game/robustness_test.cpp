@@ -37,7 +37,7 @@ std::vector<unsigned char> garment_bytes(World& world) {
     std::vector<unsigned char> bytes;
     for (Entity e : world.garments) {
         const Garment& g = world.registry.get<Garment>(e);
-        for (const Matrix3X* m : {&g.x, &g.v}) {
+        for (const Matrix3X* m : {&g.state.x, &g.state.v}) {
             const auto* p = reinterpret_cast<const unsigned char*>(m->data());
             bytes.insert(bytes.end(), p, p + sizeof(Real) * static_cast<std::size_t>(m->size()));
         }
@@ -62,14 +62,14 @@ std::vector<unsigned char> run_sample(int threads, int frames) {
 
 /// The garment's anchor ellipsoid centre (the hips for a skirt), world.
 Vec3 hip_centre(World& world, const Garment& g) {
-    const Entity anchor = g.colliders.at(static_cast<std::size_t>(g.anchor));
+    const Entity anchor = g.body.colliders.at(static_cast<std::size_t>(g.body.anchor));
     return world.registry.get<EllipsoidCollider>(anchor).world.translation();
 }
 
 /// Largest particle distance from the hip centre.
 Real farthest_from_hip(World& world) {
     const Garment& g = world.registry.get<Garment>(world.garments.at(0));
-    return (g.x.colwise() - hip_centre(world, g)).colwise().norm().maxCoeff();
+    return (g.state.x.colwise() - hip_centre(world, g)).colwise().norm().maxCoeff();
 }
 
 TEST(SampleSceneDeterminism, TwoRunsGiveIdenticalBytes) {

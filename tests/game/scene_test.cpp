@@ -31,7 +31,7 @@ void clear_locations(SceneDescription& s) {
     for (auto& c : s.colliders) c.where = {};
 }
 
-Vec3 mean_position(const Garment& g) { return g.x.rowwise().mean(); }
+Vec3 mean_position(const Garment& g) { return g.state.x.rowwise().mean(); }
 
 TEST(SampleScene, FileAndCodeDescribeTheSameScene) {
     auto file = load_scene_file(asset_dir() / "scenes" / "sample.json");
@@ -98,10 +98,10 @@ TEST(TeleportGuard, JumpResetsTheGarmentAroundTheBodyAtItsNewPlace) {
     EXPECT_EQ(world->teleports->teleports, 1u);
     EXPECT_EQ(world->teleports->resets, 1u);
     const Garment& g = world->registry.get<Garment>(world->garments[0]);
-    EXPECT_TRUE(g.x.allFinite() && g.v.allFinite());
+    EXPECT_TRUE(g.state.x.allFinite() && g.state.v.allFinite());
     EXPECT_NEAR(mean_position(g).x(), 5.0f, 0.3f);
     // The jump carried no velocity into the cloth.
-    EXPECT_LT(g.v.colwise().norm().maxCoeff(), 5.0f);
+    EXPECT_LT(g.state.v.colwise().norm().maxCoeff(), 5.0f);
     for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
     EXPECT_FALSE(has_nonfinite(*world));
     EXPECT_NEAR(mean_position(world->registry.get<Garment>(world->garments[0])).x(), 5.0f, 0.3f);
@@ -142,7 +142,7 @@ TEST(ExplicitReset, PutsTheGarmentBackAroundTheBody) {
     ASSERT_TRUE(world) << world.error().message;
     for (int frame = 0; frame < 20; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
     Garment& g = world->registry.get<Garment>(world->garments[0]);
-    g.x.colwise() += Vec3(0, 3, 0);  // fling it away
+    g.state.x.colwise() += Vec3(0, 3, 0);  // fling it away
     reset_garments(*world);
     EXPECT_LT(std::abs(mean_position(world->registry.get<Garment>(world->garments[0])).y() - 0.8f), 0.5f);
     EXPECT_EQ(world->teleports->resets, 1u);
@@ -232,8 +232,8 @@ TEST(ParticleLimit, OneLimitForScenesAndCppBuilders) {
     auto world = build_world(scene, {});
     ASSERT_TRUE(world) << world.error().message;
     const Garment& g = world->registry.get<Garment>(world->garments[0]);
-    EXPECT_LE(g.x.cols(), max_garment_particles);
-    EXPECT_GT(g.x.cols(), max_garment_particles * 9 / 10);
+    EXPECT_LE(g.state.x.cols(), max_garment_particles);
+    EXPECT_GT(g.state.x.cols(), max_garment_particles * 9 / 10);
 }
 
 TEST(BuildWorld, ErrorsFromAFileCarryItsPosition) {

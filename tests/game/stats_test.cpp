@@ -90,8 +90,8 @@ TEST(GarmentWatch, ReportsWorstValuesAndNonFiniteParticles) {
     Registry registry;
     const Entity e = registry.create();
     Garment& g = registry.emplace<Garment>(e);
-    g.x = Matrix3X::Zero(3, 4);
-    g.v = Matrix3X::Zero(3, 4);
+    g.state.x = Matrix3X::Zero(3, 4);
+    g.state.v = Matrix3X::Zero(3, 4);
     g.counters.collision_tests = 100;  // before the run: not counted
     GarmentWatch watch(registry, {e});
 
@@ -100,7 +100,7 @@ TEST(GarmentWatch, ReportsWorstValuesAndNonFiniteParticles) {
     watch.sample(registry);
     registry.get<Garment>(e).counters.collision_tests = 400;
     registry.get<Garment>(e).counters.max_strain = 0.02f;
-    registry.get<Garment>(e).x(1, 2) = std::numeric_limits<Real>::quiet_NaN();
+    registry.get<Garment>(e).state.x(1, 2) = std::numeric_limits<Real>::quiet_NaN();
     watch.sample(registry);
 
     const auto result = watch.result(registry);

@@ -64,7 +64,7 @@ struct Scene {
         garment = registry.create();
         registry.emplace<Garment>(garment, test::make_panel(0.6f, 0.4f, 0.1f, 0.8f, 17, garment_red));
     }
-    Vec3 panel_centre() { return registry.get<Garment>(garment).x.rowwise().mean(); }
+    Vec3 panel_centre() { return registry.get<Garment>(garment).state.x.rowwise().mean(); }
 };
 
 Image render(Renderer& renderer, Registry& registry) {
@@ -187,10 +187,10 @@ TEST(RenderOffscreen, GarmentNormalsFollowItsParticles) {
     Scene scene;
     Garment& garment = scene.registry.get<Garment>(scene.garment);
     const Vec3 centre = scene.panel_centre();
-    const Matrix3X flat = garment.x;
+    const Matrix3X flat = garment.state.x;
     auto shade_turned = [&](Real angle_rad) {
         const Mat3 turn = Eigen::AngleAxis<Real>(angle_rad, Vec3::UnitY()).toRotationMatrix();
-        garment.x = (turn * (flat.colwise() - centre)).colwise() + centre;
+        garment.state.x = (turn * (flat.colwise() - centre)).colwise() + centre;
         const Image image = render(*renderer, scene.registry);
         return luminance(pixel(image, *renderer->camera().project(centre, width, height)));
     };
@@ -262,9 +262,9 @@ TEST(RenderOffscreen, BadGarmentIndicesAreReportedNotDrawn) {
     auto renderer = make_renderer();
     ASSERT_TRUE(renderer);
     Scene scene;
-    auto topology = std::make_shared<GarmentTopology>(*scene.registry.get<Garment>(scene.garment).topology);
+    auto topology = std::make_shared<Fabric>(*scene.registry.get<Garment>(scene.garment).fabric);
     topology->triangles[7] = 100000;
-    scene.registry.get<Garment>(scene.garment).topology = topology;
+    scene.registry.get<Garment>(scene.garment).fabric = topology;
     renderer->draw_scene(scene.registry);
     auto image = renderer->read_pixels();
     ASSERT_FALSE(image.has_value());
@@ -293,7 +293,7 @@ TEST(RenderOffscreen, NonFiniteParticlesNeitherCrashNorMoveTheCamera) {
     renderer->camera().follow = true;
     Scene scene;
     const Real nan = std::numeric_limits<Real>::quiet_NaN();
-    scene.registry.get<Garment>(scene.garment).x.col(5).setConstant(nan);
+    scene.registry.get<Garment>(scene.garment).state.x.col(5).setConstant(nan);
     scene.registry.get<SkinnedMesh>(scene.body).positions.col(3).setConstant(nan);
     update_follow_camera(renderer->camera(), scene.registry, 0);
     EXPECT_TRUE(renderer->camera().target.allFinite()) << "one NaN vertex must not drag the camera away";

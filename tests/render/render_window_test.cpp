@@ -164,7 +164,7 @@ TEST(RenderWindow, OneFrameRendersInAnXvfbWindowAndReadsBack) {
     auto image = renderer.read_pixels();
     ASSERT_TRUE(image.has_value()) << image.error().message;
     ASSERT_EQ(image->width, 256);
-    const auto centre = camera.project(registry.get<Garment>(garment).x.rowwise().mean(), 256, 192);
+    const auto centre = camera.project(registry.get<Garment>(garment).state.x.rowwise().mean(), 256, 192);
     ASSERT_TRUE(centre);
     const std::uint8_t* p = image->at(int(centre->x_px), int(centre->y_px));
     EXPECT_GT(int(p[1]), int(p[0]) + 60) << "green garment expected, got " << int(p[0]) << "," << int(p[1]) << ","

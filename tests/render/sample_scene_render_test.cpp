@@ -73,7 +73,7 @@ TEST(SampleSceneRender, SkirtAndAvatarAppearWhereTheCameraPutsThem) {
     // The skirt's red (linear 0.75, 0.12, 0.18, lit and in sRGB about (190, 90, 110)) around
     // the projection of its centre.
     const Garment& skirt = world->registry.get<Garment>(world->garments[0]);
-    const Vec3 skirt_centre = skirt.x.rowwise().mean();
+    const Vec3 skirt_centre = skirt.state.x.rowwise().mean();
     const auto skirt_px = camera.project(skirt_centre, image->width, image->height);
     ASSERT_TRUE(skirt_px.has_value());
     const double red = share_around(*image, *skirt_px, 6, [](Rgb c) { return c.r > std::max(c.g, c.b) + 50; });

@@ -58,21 +58,21 @@ inline SkinnedMesh make_cylinder_body(Real x, Real z, Real radius_m, Real height
 /// A vertical square cloth panel of n x n particles in the plane z = z_m, lower-left corner
 /// at (x_m, y_m), facing +Z (counter-clockwise seen from +Z).
 inline Garment make_panel(Real x_m, Real y_m, Real z_m, Real size_m, int n, const Vec3& color) {
-    auto topology = std::make_shared<GarmentTopology>();
+    auto topology = std::make_shared<Fabric>();
     Garment garment;
-    garment.x.resize(3, n * n);
+    garment.state.x.resize(3, n * n);
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j)
-            garment.x.col(i * n + j) = Vec3(x_m + size_m * Real(j) / Real(n - 1), y_m + size_m * Real(i) / Real(n - 1), z_m);
+            garment.state.x.col(i * n + j) = Vec3(x_m + size_m * Real(j) / Real(n - 1), y_m + size_m * Real(i) / Real(n - 1), z_m);
     for (int i = 0; i + 1 < n; ++i)
         for (int j = 0; j + 1 < n; ++j) {
             const auto a = std::uint32_t(i * n + j), b = a + 1, c = a + std::uint32_t(n), d = c + 1;
             topology->triangles.insert(topology->triangles.end(), {a, b, c, b, d, c});
         }
-    garment.topology = std::move(topology);
-    garment.v.setZero(3, n * n);
-    garment.inv_mass.setOnes(n * n);
-    garment.color = color;
+    garment.fabric = std::move(topology);
+    garment.state.v.setZero(3, n * n);
+    garment.state.inv_mass.setOnes(n * n);
+    garment.config.color = color;
     return garment;
 }
 

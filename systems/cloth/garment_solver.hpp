@@ -1,0 +1,70 @@
+// What the cloth module keeps for one garment between steps: collider frames, pin targets,
+// candidate lists, stability bounds and scratch arrays. Private to the cloth module: users
+// read the Garment component, never this. The cloth systems attach one to every garment
+// entity (component GarmentSolver); code that steps a garment by hand keeps its own.
+//
+// Everything here is derived: a default-constructed GarmentSolver is valid and is filled on
+// the next step. It follows the garment's configuration by itself (`built_for`): a changed
+// model or material drops the caches that depend on them (systems/cloth/garment_config.hpp).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "components/garment.hpp"
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// One collider as the cloth sees it during a substep (unit sphere <-> world).
+struct EllipsoidFrame {
+    Mat3 to_unit = Mat3::Identity();   ///< diag(1/r) R^T.
+    Mat3 rotation = Mat3::Identity();  ///< R.
+    Vec3 center = Vec3::Zero();        ///< c, m.
+    Vec3 radii_m = Vec3::Ones();
+    Vec3 velocity_m_s = Vec3::Zero();
+    Vec3 acceleration_m_s2 = Vec3::Zero();
+    Vec3 angular_velocity_rad_s = Vec3::Zero();
+    bool active = false;               ///< False when the collider entity is gone: never tested.
+};
+
+/// Candidate lists with their references (method §5, spatial locality; collision.hpp step 1).
+struct CandidateLists {
+    std::vector<std::uint64_t> bits;         ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
+    bool valid = false;                      ///< False: rebuild before the next test.
+    Matrix3XRows reference_x;                ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
+    std::vector<Affine3> reference_frames;   ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed (zero: none).
+    Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
+    VectorX slack_m;                         ///< Per particle: how far it may still move before its list could miss a collider, after the last update, m.
+    Matrix3XRows scratch;                    ///< Anchor-frame positions, reused every substep.
+};
+
+struct GarmentSolver {
+    GarmentConfig built_for;                 ///< The configuration the caches below were made for.
+    bool configured = false;                 ///< False until the first step (or after invalidate()).
+
+    std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep, one per GarmentBody::colliders.
+    std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep (temporal coherence).
+    CandidateLists lists;
+
+    Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
+    std::array<Real, 2> stable_step_s{0, 0}; ///< Stability bound per model (method §3.4).
+
+    // Scratch (no allocation per step once sized).
+    Matrix3X force;                          ///< Spring forces, N.
+    Matrix3X x_start;                        ///< Positions at the start of the substep (contact velocities).
+    Matrix3X normals;                        ///< Layer-1 normals for weft placement.
+    Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.
+    std::vector<std::uint8_t> movable;       ///< Per particle: 1 unless pinned.
+    std::vector<std::uint8_t> movable_weft;  ///< Per particle: 1 for free layer-2 particles.
+};
+
+/// Sizes the scratch arrays and masks for `garment` and drops the caches that depend on a
+/// configuration other than the garment's (no-op when current).
+void prepare_solver(const Garment& garment, GarmentSolver& solver);
+
+/// Drops every cache (the next step rebuilds them).
+void invalidate(GarmentSolver& solver);
+
+}  // namespace drape

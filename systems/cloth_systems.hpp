@@ -1,0 +1,26 @@
+// The cloth step: the cloth module's one entry in the scheduler (phase simulation).
+//
+// Each fixed step it gathers the garments (creating a solver for a garment that has none),
+// takes the substeps of the rule in systems/cloth/substeps.hpp (the largest need of all
+// garments, or ClothSolverSettings::fixed_substeps), and runs, in every substep, the three
+// cloth systems in their order:
+//   cloth_integration  (cloth_integration_system.hpp)  method §3.3-§3.5
+//   cloth_constraint   (cloth_constraint_system.hpp)   method §4
+//   cloth_collision    (cloth_collision_system.hpp)    method §5
+// The scheduler times the whole step as "cloth"; each system is timed in a profiler slot of
+// its own under it, so the frame budget lists all four.
+#pragma once
+
+#include "engine/core/scheduler.hpp"
+#include "systems/cloth/substeps.hpp"
+
+namespace drape {
+
+/// Adds the cloth step to `scheduler`. Returns its profiler slot.
+std::uint32_t add_cloth_systems(Scheduler& scheduler, const ClothSolverSettings& settings = {});
+
+/// Every garment of `registry` through one fixed step of `fixed_dt_s`, as the cloth step runs
+/// it, without timing (tools that drive the cloth themselves).
+void step_cloth(Registry& registry, double fixed_dt_s, const ClothSolverSettings& settings = {});
+
+}  // namespace drape
