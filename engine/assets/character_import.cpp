@@ -25,7 +25,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include "systems/character/pose.hpp"
+#include "engine/assets/skinning.hpp"
 
 namespace drape {
 
