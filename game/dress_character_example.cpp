@@ -50,16 +50,18 @@ int main(int argc, char** argv) {
     const int frames = argc > 3 ? std::atoi(argv[3]) : 300;
     if (frames <= 0) return fail_with("FRAMES must be a positive integer");
 
-    // 1. Import: skeleton, skin, clips in metres and seconds; ellipsoid colliders fitted
-    //    to the bones from the skin weights (method §2).
+    // 1. Import: skeleton, skin, clips in metres and seconds; then the body: ellipsoid
+    //    colliders fitted to the bones from the skin weights (method §2).
     auto asset = drape::import_character(file);
     if (!asset) return fail_with(asset.error().message);
+    auto body = drape::fit_character_body(**asset);
+    if (!body) return fail_with(body.error().message);
 
     // 2. Spawn: the character entity and one entity per collider, posed and skinned.
     drape::Registry registry;
     drape::SpawnOptions spawn;
     spawn.clip = clip;  // empty: the importer's first clip
-    auto character = drape::spawn_character(registry, *asset, spawn);
+    auto character = drape::spawn_character(registry, *asset, *body, spawn);
     if (!character) return fail_with(character.error().message);
 
     // 3. Systems: animation, skinning, colliders, then the cloth's three systems.

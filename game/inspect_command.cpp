@@ -7,6 +7,7 @@
 
 #include "engine/assets/character_import.hpp"
 #include "game/commands.hpp"
+#include "systems/character/character_body.hpp"
 #include "systems/character/character_report.hpp"
 
 namespace drape {
@@ -38,9 +39,15 @@ void add_inspect_command(CLI::App& app) {
             return;
         }
         for (const std::string& warning : (*character)->warnings) std::fprintf(stderr, "drape inspect: warning: %s\n", warning.c_str());
-        const CoverageReport coverage = rest_pose_coverage(**character);
-        const std::string report = o->json ? character_report_json(**character, coverage)
-                                           : character_report_text(**character, coverage);
+        auto body = fit_character_body(**character);
+        if (!body) {
+            std::fprintf(stderr, "drape inspect: %s\n", body.error().message.c_str());
+            command_exit_code() = 1;
+            return;
+        }
+        const CoverageReport coverage = rest_pose_coverage(**character, *body);
+        const std::string report = o->json ? character_report_json(**character, *body, coverage)
+                                           : character_report_text(**character, *body, coverage);
         std::fputs(report.c_str(), stdout);
     });
 }

@@ -15,6 +15,7 @@
 #include "components/skinned_mesh.hpp"
 #include "components/transform.hpp"
 #include "engine/assets/character_import.hpp"
+#include "systems/character/character_body.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
 #include "systems/cloth/garment_config.hpp"
@@ -234,18 +235,25 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
                                                                    static_cast<std::size_t>(scene.solver.threads));
     world.scheduler.profiler().set_timing(options.profile);
 
-    // Characters (one import per file), then collider overrides.
-    std::map<fs::path, std::shared_ptr<const CharacterAsset>> assets;
+    // Characters (one import and one fitted body per file), then collider overrides.
+    struct Loaded {
+        std::shared_ptr<const CharacterAsset> asset;
+        CharacterBody body;
+    };
+    std::map<fs::path, Loaded> loaded;
     for (std::size_t i = 0; i < scene.characters.size(); ++i) {
         const CharacterDescription& c = scene.characters[i];
         const std::string field = "characters[" + std::to_string(i) + "].file";
-        auto& asset = assets[c.file];
-        if (!asset) {
+        Loaded& character = loaded[c.file];
+        if (!character.asset) {
             auto imported = import_character(c.file);
             if (!imported) return fail(located(c.where, field, imported.error().message));
-            asset = *imported;
-            world.warnings.insert(world.warnings.end(), asset->warnings.begin(), asset->warnings.end());
+            auto body = fit_character_body(**imported);
+            if (!body) return fail(located(c.where, field, body.error().message));
+            character = {*imported, std::move(*body)};
+            world.warnings.insert(world.warnings.end(), character.asset->warnings.begin(), character.asset->warnings.end());
         }
+        const std::shared_ptr<const CharacterAsset>& asset = character.asset;
         SpawnOptions spawn;
         spawn.transform.position = c.position_m;
         spawn.transform.rotation = c.rotation();
@@ -257,7 +265,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
             if (auto clip = find_clip(*asset, c.clip); !clip)
                 return fail(located(c.where, "characters[" + std::to_string(i) + "].clip", clip.error().message));
         }
-        auto entity = spawn_character(world.registry, asset, spawn);
+        auto entity = spawn_character(world.registry, asset, character.body, spawn);
         if (!entity) return fail(located(c.where, "characters[" + std::to_string(i) + "]", entity.error().message));
         world.characters.push_back(*entity);
         if (auto ok = apply_collider_overrides(world, scene, i, *asset); !ok) return std::unexpected(ok.error());

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "components/character.hpp"
 #include "components/ellipsoid_collider.hpp"
@@ -10,6 +11,66 @@
 #include "components/skinned_mesh.hpp"
 
 namespace drape {
+namespace {
+
+// Cloth is matte and thin: seen from behind it is lit with the flipped normal.
+constexpr SurfaceLook cloth_look{.specular = Real(0.06), .shininess = 12, .rim = Real(0.15), .two_sided = true};
+
+std::uint64_t object_of(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
+
+// Which of an entity's meshes a DrawKey names (an entity could hold a skin and a garment).
+enum MeshPart : std::uint32_t { skin_part = 0, garment_part = 1 };
+
+void add_skinned_meshes(Registry& registry, DrawList& list) {
+    registry.view<SkinnedMesh>().each([&](Entity e, SkinnedMesh& skin) {
+        if (!skin.mesh || skin.positions.cols() == 0) return;
+        const MeshAsset& mesh = *skin.mesh;
+        const std::string name = "skinned mesh of entity " + std::to_string(e.index);
+        if (skin.positions.cols() != Eigen::Index(mesh.vertex_count())) {
+            list.problems.push_back(name + ": " + std::to_string(skin.positions.cols()) + " skinned positions for a mesh of " +
+                                    std::to_string(mesh.vertex_count()) + " vertices");
+            return;
+        }
+        MeshDraw& draw = list.meshes.emplace_back();
+        draw.key = {object_of(e), skin_part};
+        draw.name = name;
+        draw.positions = &skin.positions;
+        draw.normals = skin.normals.cols() == skin.positions.cols() ? &skin.normals : nullptr;
+        draw.triangles = mesh.indices;
+        for (const Submesh& s : mesh.submeshes) draw.ranges.push_back({s.first_index, s.index_count, s.color, s.name});
+        draw.contact_shadow = true;
+    });
+}
+
+void add_garments(Registry& registry, DrawList& list) {
+    registry.view<Garment>().each([&](Entity e, Garment& garment) {
+        if (!garment.fabric || garment.state.x.cols() == 0 || garment.fabric->triangles.empty()) return;
+        MeshDraw& draw = list.meshes.emplace_back();
+        draw.key = {object_of(e), garment_part};
+        draw.name = "garment of entity " + std::to_string(e.index);
+        draw.positions = &garment.state.x;
+        draw.normals = nullptr;  // from the particles, every frame
+        draw.triangles = garment.fabric->triangles;
+        draw.color = garment.config.color;
+        draw.look = cloth_look;
+    });
+}
+
+}  // namespace
+
+void build_draw_list(Registry& registry, bool show_ellipsoids, DrawList& list) {
+    list.clear();
+    add_skinned_meshes(registry, list);
+    add_garments(registry, list);
+    if (show_ellipsoids)
+        registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) { list.ellipsoids.push_back(c.world); });
+}
+
+void draw_registry(Renderer& renderer, Registry& registry) {
+    DrawList list;
+    build_draw_list(registry, renderer.show_ellipsoids(), list);
+    renderer.draw(list);
+}
 
 std::optional<Vec3> follow_target(Registry& registry, const Camera& camera) {
     // The first character: lowest entity index among skinned meshes that are characters,
@@ -54,10 +115,12 @@ System make_render_system(Renderer& renderer) {
     system.phase = Phase::render;
     system.reads = components<SkinnedMesh>();
     system.optional_reads = components<Garment, EllipsoidCollider, Character>();
-    system.run = [&renderer, first = true](Registry& registry, const FrameContext& context) mutable {
+    // The list lives with the system, so its buffers are reused from frame to frame.
+    system.run = [&renderer, first = true, list = DrawList{}](Registry& registry, const FrameContext& context) mutable {
         update_follow_camera(renderer.camera(), registry, first ? 0.0 : context.frame_dt_s);
         first = false;
-        renderer.draw_scene(registry);
+        build_draw_list(registry, renderer.show_ellipsoids(), list);
+        renderer.draw(list);
     };
     return system;
 }

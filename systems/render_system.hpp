@@ -3,7 +3,9 @@
 // Reads SkinnedMesh (gates the run); reads Garment, EllipsoidCollider and Character when
 // present. Before drawing it moves the camera's target to the first character (the one
 // with the lowest entity index) when `Camera::follow` is set. The target comes from the
-// skinned vertices themselves, so it follows root motion and in-place clips alike.
+// skinned vertices themselves, so it follows root motion and in-place clips alike. Then it
+// turns the components into the renderer's DrawList (build_draw_list) and draws it; the
+// renderer knows nothing of components.
 #pragma once
 
 #include <optional>
@@ -18,6 +20,18 @@ namespace drape {
 
 /// The render system. The renderer must outlive the scheduler that runs it.
 [[nodiscard]] System make_render_system(Renderer& renderer);
+
+/// Fills `list` (cleared first) with the registry's scene, in this order: every
+/// SkinnedMesh with vertices (lit, one colour per submesh, a contact shadow), then every
+/// Garment with particles and triangles (two-sided cloth in its colour, normals from its
+/// particles), and each EllipsoidCollider's world shape when `show_ellipsoids`. Skinned
+/// positions that do not match their mesh leave that mesh out, named in `list.problems`.
+/// The list points into the components: draw it before they change.
+void build_draw_list(Registry& registry, bool show_ellipsoids, DrawList& list);
+
+/// Builds the registry's draw list and draws it: the render system's frame without the
+/// camera follow.
+void draw_registry(Renderer& renderer, Registry& registry);
 
 /// Where the camera should look for the first character: the centre of its skinned
 /// vertices' bounds horizontally, `camera.follow_height_ratio` of its height above its

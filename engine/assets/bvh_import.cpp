@@ -14,7 +14,7 @@
 #include <assimp/scene.h>
 
 #include "engine/assets/character_import.hpp"
-#include "systems/character/pose.hpp"
+#include "engine/assets/skinning.hpp"
 
 namespace drape {
 

@@ -2,18 +2,19 @@
 //
 // Conventions after import (method §1, §2): metres, Y up, model space = the file's scene
 // root after the unit and axis correction; every vertex has at most 4 bone influences
-// whose weights sum to 1; clip times in seconds.
+// whose weights sum to 1; clip times in seconds. What Drape derives from a character for
+// its garments (fitted ellipsoids, the hip bone) is systems/character/character_body.hpp.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "components/animation_player.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
+#include "engine/assets/animation_clip.hpp"
+#include "engine/assets/mesh_asset.hpp"
+#include "engine/assets/skeleton_asset.hpp"
 #include "engine/core/math.hpp"
 
 namespace drape {
@@ -41,13 +42,11 @@ struct CharacterAsset {
     std::shared_ptr<const SkeletonAsset> skeleton;
     std::shared_ptr<const MeshAsset> mesh;               ///< All meshes of the file, merged.
     std::vector<std::shared_ptr<const AnimationClip>> clips;
-    std::vector<EllipsoidShape> ellipsoids;             ///< Fitted, bone space: bone, center, rotation, radii_m.
     std::vector<MeshInfo> meshes;
     Real height_m = 0;                                  ///< Vertical extent of the rest pose.
     double scale = 1;                                   ///< File units -> metres that was applied.
     ScaleSource scale_source = ScaleSource::file_units;
     int skin_bones = 0;                                 ///< Bones that move at least one vertex.
-    int hip_bone = -1;                                  ///< find_hip_bone(); -1 when none.
     /// What the import accepted but a user may want to know (e.g. zero-length end bones
     /// without weights): one line each, naming the file.
     std::vector<std::string> warnings;

@@ -4,7 +4,8 @@
 // animated node, and their ancestors up to the scene root, in depth-first order so parents
 // precede children); build one merged mesh (skinned vertices keep their file weights,
 // limited to 4 and normalised; rigid meshes get weight 1 on the bone they hang from);
-// convert clips to seconds; correct axes, then units; measure height; fit ellipsoids.
+// convert clips to seconds; correct axes, then units; measure height. Fitting ellipsoids
+// to the result is the character systems' work (systems/character/character_body.hpp).
 #include "engine/assets/character_import.hpp"
 
 #include <algorithm>
@@ -25,7 +26,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include "systems/character/pose.hpp"
+#include "engine/assets/skinning.hpp"
 
 namespace drape {
 
@@ -550,7 +551,7 @@ Result<void> validate(const ImportOptions& o) {
     if (!(std::isfinite(o.fallback_height_m) && o.fallback_height_m > 0)) return fail("fallback_height_m: must be > 0");
     if (!(o.min_plausible_height_m > 0 && o.max_plausible_height_m > o.min_plausible_height_m))
         return fail("min/max_plausible_height_m: need 0 < min < max");
-    return validate(o.fit);
+    return {};
 }
 
 void compute_clip_travel(AnimationClip& clip, const SkeletonAsset& skeleton) {
@@ -669,12 +670,8 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     asset->height_m = rest_height(skeleton, *mesh);
     asset->skin_bones = static_cast<int>(std::count(moves.begin(), moves.end(), true));
     asset->warnings = std::move(b.warnings);
-    auto shared_skeleton = std::make_shared<const SkeletonAsset>(std::move(skeleton));
-    asset->skeleton = shared_skeleton;
-    asset->hip_bone = find_hip_bone(*shared_skeleton);
+    asset->skeleton = std::make_shared<const SkeletonAsset>(std::move(skeleton));
     for (auto& clip : clips) asset->clips.push_back(std::move(clip));
-    if (options.fit_ellipsoids)
-        asset->ellipsoids = fit_ellipsoids(*shared_skeleton, *mesh, asset->height_m, options.fit, asset->clips);
     asset->mesh = std::move(mesh);
     return std::shared_ptr<const CharacterAsset>(std::move(asset));
 }

@@ -20,7 +20,6 @@
 
 #include "engine/assets/character_asset.hpp"
 #include "engine/core/error.hpp"
-#include "systems/character/ellipsoid_fit.hpp"
 
 namespace drape {
 
@@ -31,8 +30,6 @@ struct ImportOptions {
     double min_plausible_height_m = 0.3;
     double max_plausible_height_m = 2.6;
     bool require_animation = true;      ///< A file without clips is an error (set false to add BVH clips later).
-    bool fit_ellipsoids = true;
-    FitOptions fit;
 };
 
 /// Checks the options; the error names the field.

@@ -1,13 +1,15 @@
-// The renderer: context, frame buffers and the scene pass.
+// The renderer: context, frame buffers and the scene pass over a DrawList.
 //
-// Frame: bind the (multisampled) draw framebuffer, clear; ground with blob contact
-// shadows; planar shadows of bodies and garments along the key light (stencil: each pixel
-// darkened once); bodies; garments (two-sided); translucent ellipsoids; resolve into a
-// single-sample framebuffer that read_pixels() reads and present() blits to the window.
+// Frame (Impl::draw, one function per step): upload the list's meshes and find their
+// contact shadows; free the buffers of meshes no longer listed; bind the (multisampled)
+// draw framebuffer, clear; ground; blob contact shadows; planar shadows of the casters
+// along the key light (stencil: each pixel darkened once); the lit meshes in list order;
+// translucent ellipsoids; resolve into a single-sample framebuffer that read_pixels()
+// reads and present() blits to the window.
 //
-// GPU buffers are kept per entity and updated with glNamedBufferSubData each frame; they
-// are created when an entity first appears (or its mesh changes) and freed when it is gone,
-// so a steady scene allocates nothing per frame.
+// GPU buffers are kept per DrawKey and updated with glNamedBufferSubData each frame; they
+// are created when a key first appears (or its vertex count or triangle list changes) and
+// freed when a frame no longer lists it, so a steady scene allocates nothing per frame.
 #include "engine/render/renderer.hpp"
 
 #include <algorithm>
@@ -16,13 +18,11 @@
 #include <cstdio>
 #include <cstring>
 #include <numbers>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skinned_mesh.hpp"
 #include "engine/render/egl_context.hpp"
 #include "engine/render/gl.hpp"
 #include "engine/render/shaders.hpp"
@@ -53,7 +53,13 @@ Vec3 tone_map(const Vec3& linear) {
     return (x * (1 + x * Real(0.25)) / (1 + x)).sqrt().matrix();
 }
 
-std::uint64_t key_of(Entity e) { return (std::uint64_t(e.index) << 32) | e.generation; }
+struct DrawKeyHash {
+    std::size_t operator()(const DrawKey& key) const noexcept {
+        return std::hash<std::uint64_t>{}(key.object * 0x9E3779B97F4A7C15ull ^ key.part);
+    }
+};
+
+Vec3 clamp01(const Vec3& color) { return color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones()); }
 
 Mat3 normal_matrix(const Affine3& m) { return m.linear().inverse().transpose(); }
 
@@ -109,7 +115,7 @@ struct MeshBuffers {
 };
 
 /// Area-weighted vertex normals of a triangle list (counter-clockwise = front).
-void compute_normals(const Matrix3X& x, const std::vector<std::uint32_t>& triangles, Matrix3X& normals) {
+void compute_normals(const Matrix3X& x, std::span<const std::uint32_t> triangles, Matrix3X& normals) {
     normals.setZero(3, x.cols());
     for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
         const auto a = triangles[t], b = triangles[t + 1], c = triangles[t + 2];
@@ -126,7 +132,7 @@ void compute_normals(const Matrix3X& x, const std::vector<std::uint32_t>& triang
 }
 
 /// First index that is out of range, or -1.
-long long first_bad_index(const std::vector<std::uint32_t>& indices, std::size_t vertex_count) {
+long long first_bad_index(std::span<const std::uint32_t> indices, std::size_t vertex_count) {
     for (std::size_t i = 0; i < indices.size(); ++i)
         if (indices[i] >= vertex_count) return static_cast<long long>(i);
     return -1;
@@ -161,22 +167,30 @@ struct Renderer::Impl {
     } shadow_u{};
     MeshBuffers sphere;
 
-    struct BodyEntry {
+    /// The GPU side of one DrawKey, kept between frames.
+    struct MeshEntry {
         MeshBuffers buffers;
-        const MeshAsset* mesh = nullptr;
-        Matrix3X computed_normals;  // when the skin carries no normals
-        std::uint64_t seen = 0;
+        const std::uint32_t* triangles = nullptr;  // the index data the buffers hold; null: nothing valid
+        std::size_t index_count = 0;
+        Matrix3X computed_normals;                 // when the mesh comes without normals
+        std::uint64_t seen = 0;                    // the last frame that listed it
     };
-    struct GarmentEntry {
-        MeshBuffers buffers;
-        const Fabric* topology = nullptr;
-        Matrix3X normals;
-        Vec3 color = Vec3::Zero();
-        std::uint64_t seen = 0;
+    /// A listed mesh whose buffers are valid and uploaded this frame.
+    struct ReadyMesh {
+        const MeshDraw* mesh;
+        const MeshEntry* entry;
     };
-    std::unordered_map<std::uint64_t, BodyEntry> bodies;
-    std::unordered_map<std::uint64_t, GarmentEntry> garments;
-    std::vector<std::uint64_t> stale;   // scratch
+    /// The camera and the key light of a frame.
+    struct FrameView {
+        Mat4 view_projection;
+        Vec3 eye;
+        Vec3 key_direction;  // towards the light, as in the shaders
+    };
+    std::unordered_map<DrawKey, MeshEntry, DrawKeyHash> meshes;
+    std::vector<ReadyMesh> ready;                   // this frame's drawable meshes, in list order
+    std::array<Eigen::Vector4f, max_blobs> blobs{}; // this frame's contact shadows: centre x, z, radius, strength
+    int blob_count = 0;
+    std::vector<DrawKey> stale;         // scratch
     std::vector<std::uint8_t> readback; // scratch, bottom row first
     std::uint64_t frame = 0;
     std::string frame_error;            // first problem of the last draw
@@ -184,8 +198,7 @@ struct Renderer::Impl {
 
     ~Impl() {
         if (!context || !context->make_current()) return;
-        for (auto& [key, body] : bodies) body.buffers.destroy();
-        for (auto& [key, garment] : garments) garment.buffers.destroy();
+        for (auto& [key, entry] : meshes) entry.buffers.destroy();
         sphere.destroy();
         glDeleteProgram(lit);
         glDeleteProgram(ground);
@@ -205,7 +218,20 @@ struct Renderer::Impl {
     Result<void> create_framebuffers();
     Result<void> create_programs();
     void create_sphere();
-    void draw(Registry& registry);
+
+    void draw(const DrawList& list);
+    // The steps of a frame, in order.
+    void upload_meshes(const DrawList& list);
+    [[nodiscard]] bool prepare_buffers(const MeshDraw& mesh, MeshEntry& entry);
+    void find_contact_blobs();
+    void free_unlisted_buffers();
+    void clear_frame();
+    void draw_ground(const FrameView& view);
+    void draw_contact_blobs(const FrameView& view);
+    void draw_planar_shadows(const FrameView& view);
+    void draw_lit_meshes(const FrameView& view);
+    void draw_ellipsoids(const FrameView& view, const DrawList& list);
+    void resolve();
     GLuint read_fbo() const { return resolve_fbo != 0 ? resolve_fbo : draw_fbo; }
 };
 
@@ -295,123 +321,115 @@ void Renderer::Impl::create_sphere() {
     sphere.upload(p, p);  // unit sphere: normal = position
 }
 
-void Renderer::Impl::draw(Registry& registry) {
+void Renderer::Impl::draw(const DrawList& list) {
     ++frame;
     frame_error.clear();
-    const GLsizei w = settings.width, h = settings.height;
-    const Mat4 view_projection = camera.projection(Real(w) / Real(h)) * camera.view();
-    const Vec3 eye = camera.eye();
-    const Vec3 key_direction = Vec3(-0.45f, 0.80f, 0.55f).normalized();  // as in the shaders
+    if (!list.problems.empty()) note(list.problems.front());
+    const FrameView view{camera.projection(Real(settings.width) / Real(settings.height)) * camera.view(), camera.eye(),
+                         Vec3(-0.45f, 0.80f, 0.55f).normalized()};
+    upload_meshes(list);
+    find_contact_blobs();
+    free_unlisted_buffers();
+    clear_frame();
+    draw_ground(view);
+    draw_contact_blobs(view);
+    draw_planar_shadows(view);
+    draw_lit_meshes(view);
+    draw_ellipsoids(view, list);
+    resolve();
+    drawn = true;
+}
 
-    // --- Gather and upload: bodies -------------------------------------------------------
-    std::array<Eigen::Vector4f, max_blobs> blobs;
-    int blob_count = 0;
-    registry.view<SkinnedMesh>().each([&](Entity e, SkinnedMesh& skin) {
-        if (!skin.mesh || skin.positions.cols() == 0) return;
-        const MeshAsset& mesh = *skin.mesh;
-        BodyEntry& entry = bodies[key_of(e)];
+// Uploads positions and normals of every listed mesh whose data is valid; those become
+// this frame's `ready` meshes. A bad mesh is left out and noted.
+void Renderer::Impl::upload_meshes(const DrawList& list) {
+    ready.clear();
+    for (const MeshDraw& mesh : list.meshes) {
+        if (mesh.positions == nullptr || mesh.positions->cols() == 0 || mesh.triangles.empty()) continue;
+        MeshEntry& entry = meshes[mesh.key];
         entry.seen = frame;
-        if (entry.mesh != &mesh || entry.buffers.vertex_count != skin.positions.cols()) {
-            entry.buffers.destroy();
-            entry.mesh = nullptr;
-            if (skin.positions.cols() != Eigen::Index(mesh.vertex_count())) {
-                note("skinned mesh of entity " + std::to_string(e.index) + ": " + std::to_string(skin.positions.cols()) +
-                     " skinned positions for a mesh of " + std::to_string(mesh.vertex_count()) + " vertices");
-                return;
-            }
-            if (mesh.indices.size() % 3 != 0) {
-                note("skinned mesh of entity " + std::to_string(e.index) + ": index count " +
-                     std::to_string(mesh.indices.size()) + " is not a multiple of 3");
-                return;
-            }
-            if (auto bad = first_bad_index(mesh.indices, mesh.vertex_count()); bad >= 0) {
-                note("skinned mesh of entity " + std::to_string(e.index) + ": indices[" + std::to_string(bad) +
-                     "] = " + std::to_string(mesh.indices[std::size_t(bad)]) + " is past its " +
-                     std::to_string(mesh.vertex_count()) + " vertices");
-                return;
-            }
-            for (const Submesh& s : mesh.submeshes)
-                if (std::uint64_t(s.first_index) + s.index_count > mesh.indices.size()) {
-                    note("skinned mesh of entity " + std::to_string(e.index) + ": submesh \"" + s.name +
-                         "\" reaches past the index list");
-                    return;
-                }
-            entry.buffers.create(GLsizei(skin.positions.cols()), mesh.indices.data(), GLsizei(mesh.indices.size()));
-            entry.mesh = &mesh;
-        }
-        if (skin.normals.cols() == skin.positions.cols()) {
-            entry.buffers.upload(skin.positions, skin.normals);
+        if (!prepare_buffers(mesh, entry)) continue;
+        const Matrix3X& positions = *mesh.positions;
+        if (mesh.normals != nullptr && mesh.normals->cols() == positions.cols()) {
+            entry.buffers.upload(positions, *mesh.normals);
         } else {
-            compute_normals(skin.positions, mesh.indices, entry.computed_normals);
-            entry.buffers.upload(skin.positions, entry.computed_normals);
+            compute_normals(positions, mesh.triangles, entry.computed_normals);
+            entry.buffers.upload(positions, entry.computed_normals);
         }
-        // Contact shadow: a soft blob under the footprint of the body's lowest quarter (the
-        // feet and legs, not the swinging arms), fading as the body leaves the ground.
-        if (blob_count < max_blobs) {
-            if (const auto bounds = finite_bounds(skin.positions)) {
-                const Vec3& lo = bounds->lo;
-                const Vec3& hi = bounds->hi;
-                const Real feet_top = lo.y() + Real(0.25) * (hi.y() - lo.y());
-                Eigen::Vector2f feet_lo(hi.x(), hi.z()), feet_hi(lo.x(), lo.z());
-                for (Eigen::Index i = 0; i < skin.positions.cols(); ++i)
-                    if (skin.positions(1, i) <= feet_top && skin.positions.col(i).allFinite()) {
-                        const Eigen::Vector2f q(skin.positions(0, i), skin.positions(2, i));
-                        feet_lo = feet_lo.cwiseMin(q);
-                        feet_hi = feet_hi.cwiseMax(q);
-                    }
-                const Eigen::Vector2f extent = feet_hi - feet_lo;
-                const Real radius = std::clamp(Real(0.9) * extent.maxCoeff(), Real(0.2), Real(1.0));
-                const Real lift = std::clamp(lo.y() / Real(0.5), Real(0), Real(1));
-                const Eigen::Vector2f centre = Real(0.5) * (feet_lo + feet_hi);
-                blobs[std::size_t(blob_count++)] = Eigen::Vector4f(centre.x(), centre.y(), radius, Real(0.8) * (1 - lift));
-            }
-        }
-    });
+        ready.push_back({&mesh, &entry});
+    }
+}
 
-    // --- Gather and upload: garments -----------------------------------------------------
-    registry.view<Garment>().each([&](Entity e, Garment& garment) {
-        if (!garment.fabric || garment.state.x.cols() == 0 || garment.fabric->triangles.empty()) return;
-        const Fabric& topology = *garment.fabric;
-        GarmentEntry& entry = garments[key_of(e)];
-        entry.seen = frame;
-        if (entry.topology != &topology || entry.buffers.vertex_count != garment.state.x.cols()) {
-            entry.buffers.destroy();
-            entry.topology = nullptr;
-            if (topology.triangles.size() % 3 != 0) {
-                note("garment of entity " + std::to_string(e.index) + ": triangle index count " +
-                     std::to_string(topology.triangles.size()) + " is not a multiple of 3");
-                return;
-            }
-            if (auto bad = first_bad_index(topology.triangles, std::size_t(garment.state.x.cols())); bad >= 0) {
-                note("garment of entity " + std::to_string(e.index) + ": triangles[" + std::to_string(bad) + "] = " +
-                     std::to_string(topology.triangles[std::size_t(bad)]) + " is past its " +
-                     std::to_string(garment.state.x.cols()) + " particles");
-                return;
-            }
-            entry.buffers.create(GLsizei(garment.state.x.cols()), topology.triangles.data(), GLsizei(topology.triangles.size()));
-            entry.topology = &topology;
+// (Re)creates the buffers of a mesh when its vertex count or triangle list changed; the
+// index check runs then, not every frame. Ranges are checked every frame (they are few).
+bool Renderer::Impl::prepare_buffers(const MeshDraw& mesh, MeshEntry& entry) {
+    const Eigen::Index vertices = mesh.positions->cols();
+    if (entry.triangles != mesh.triangles.data() || entry.index_count != mesh.triangles.size() ||
+        entry.buffers.vertex_count != vertices) {
+        entry.buffers.destroy();
+        entry.triangles = nullptr;
+        entry.index_count = 0;
+        if (mesh.triangles.size() % 3 != 0) {
+            note(mesh.name + ": triangle index count " + std::to_string(mesh.triangles.size()) + " is not a multiple of 3");
+            return false;
         }
-        compute_normals(garment.state.x, topology.triangles, entry.normals);
-        entry.buffers.upload(garment.state.x, entry.normals);
-        entry.color = garment.config.color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones());
-    });
-
-    // Free the buffers of entities that are gone.
-    auto sweep = [&](auto& map) {
-        stale.clear();
-        for (auto& [key, entry] : map)
-            if (entry.seen != frame) stale.push_back(key);
-        for (std::uint64_t key : stale) {
-            map[key].buffers.destroy();
-            map.erase(key);
+        if (auto bad = first_bad_index(mesh.triangles, std::size_t(vertices)); bad >= 0) {
+            note(mesh.name + ": triangles[" + std::to_string(bad) + "] = " + std::to_string(mesh.triangles[std::size_t(bad)]) +
+                 " is past its " + std::to_string(vertices) + " vertices");
+            return false;
         }
-    };
-    sweep(bodies);
-    sweep(garments);
+        entry.buffers.create(GLsizei(vertices), mesh.triangles.data(), GLsizei(mesh.triangles.size()));
+        entry.triangles = mesh.triangles.data();
+        entry.index_count = mesh.triangles.size();
+    }
+    for (const DrawRange& range : mesh.ranges)
+        if (std::uint64_t(range.first_index) + range.index_count > mesh.triangles.size()) {
+            note(mesh.name + ": range \"" + std::string(range.name) + "\" reaches past the triangle list");
+            return false;
+        }
+    return true;
+}
 
-    // --- Clear ---------------------------------------------------------------------------
+// Contact shadow: a soft blob under the footprint of a body's lowest quarter (the feet and
+// legs, not the swinging arms), fading as the body leaves the ground.
+void Renderer::Impl::find_contact_blobs() {
+    blob_count = 0;
+    for (const ReadyMesh& r : ready) {
+        if (!r.mesh->contact_shadow || blob_count >= max_blobs) continue;
+        const Matrix3X& positions = *r.mesh->positions;
+        const auto bounds = finite_bounds(positions);
+        if (!bounds) continue;
+        const Vec3& lo = bounds->lo;
+        const Vec3& hi = bounds->hi;
+        const Real feet_top = lo.y() + Real(0.25) * (hi.y() - lo.y());
+        Eigen::Vector2f feet_lo(hi.x(), hi.z()), feet_hi(lo.x(), lo.z());
+        for (Eigen::Index i = 0; i < positions.cols(); ++i)
+            if (positions(1, i) <= feet_top && positions.col(i).allFinite()) {
+                const Eigen::Vector2f q(positions(0, i), positions(2, i));
+                feet_lo = feet_lo.cwiseMin(q);
+                feet_hi = feet_hi.cwiseMax(q);
+            }
+        const Eigen::Vector2f extent = feet_hi - feet_lo;
+        const Real radius = std::clamp(Real(0.9) * extent.maxCoeff(), Real(0.2), Real(1.0));
+        const Real lift = std::clamp(lo.y() / Real(0.5), Real(0), Real(1));
+        const Eigen::Vector2f centre = Real(0.5) * (feet_lo + feet_hi);
+        blobs[std::size_t(blob_count++)] = Eigen::Vector4f(centre.x(), centre.y(), radius, Real(0.8) * (1 - lift));
+    }
+}
+
+void Renderer::Impl::free_unlisted_buffers() {
+    stale.clear();
+    for (auto& [key, entry] : meshes)
+        if (entry.seen != frame) stale.push_back(key);
+    for (const DrawKey& key : stale) {
+        meshes[key].buffers.destroy();
+        meshes.erase(key);
+    }
+}
+
+void Renderer::Impl::clear_frame() {
     glBindFramebuffer(GL_FRAMEBUFFER, draw_fbo);
-    glViewport(0, 0, w, h);
+    glViewport(0, 0, settings.width, settings.height);
     const Vec3 clear = tone_map(settings.clear_color);
     glClearColor(clear.x(), clear.y(), clear.z(), 1);
     glClearStencil(0);
@@ -422,116 +440,118 @@ void Renderer::Impl::draw(Registry& registry) {
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     if (info.msaa_samples > 0) glEnable(GL_MULTISAMPLE);
+}
 
-    // --- Ground ---------------------------------------------------------------------------
+void Renderer::Impl::draw_ground(const FrameView& view) {
     glUseProgram(ground);
-    glUniformMatrix4fv(ground_u.view_projection, 1, GL_FALSE, view_projection.data());
+    glUniformMatrix4fv(ground_u.view_projection, 1, GL_FALSE, view.view_projection.data());
     glUniform2f(ground_u.center, std::round(camera.target.x()), std::round(camera.target.z()));
     glUniform1f(ground_u.half_size, 80.0f);
     glUniform3fv(ground_u.sky, 1, settings.clear_color.data());
     glUniform3f(ground_u.albedo, 0.38f, 0.37f, 0.35f);
     glBindVertexArray(empty_vao);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+}
 
-    // --- Contact shadow blobs, multiplied into the ground ----------------------------------
+// The blobs are multiplied into the ground (the empty vertex array is still bound).
+void Renderer::Impl::draw_contact_blobs(const FrameView& view) {
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_DST_COLOR, GL_ZERO);
     glUseProgram(blob);
-    glUniformMatrix4fv(blob_u.view_projection, 1, GL_FALSE, view_projection.data());
+    glUniformMatrix4fv(blob_u.view_projection, 1, GL_FALSE, view.view_projection.data());
     for (int i = 0; i < blob_count; ++i) {
         glUniform4fv(blob_u.blob, 1, blobs[std::size_t(i)].data());
         glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     }
+}
 
-    // --- Planar shadows: every caster flattened onto the ground, each pixel darkened once.
+// Every caster flattened onto the ground, each pixel darkened once (stencil). Runs with
+// depth writes off and blending on, as the blobs left them.
+void Renderer::Impl::draw_planar_shadows(const FrameView& view) {
     glUseProgram(shadow);
-    glUniformMatrix4fv(shadow_u.view_projection, 1, GL_FALSE, view_projection.data());
-    const Mat4 flatten = planar_shadow_matrix(key_direction, Real(0.002));
+    glUniformMatrix4fv(shadow_u.view_projection, 1, GL_FALSE, view.view_projection.data());
+    const Mat4 flatten = planar_shadow_matrix(view.key_direction, Real(0.002));
     glUniformMatrix4fv(shadow_u.shadow, 1, GL_FALSE, flatten.data());
     glUniform1f(shadow_u.darkness, 0.38f);
     glEnable(GL_STENCIL_TEST);
     glStencilFunc(GL_EQUAL, 0, 0xFF);
     glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    for (auto& [key, body] : bodies)
-        if (body.mesh != nullptr) {
-            glBindVertexArray(body.buffers.vao);
-            glDrawElements(GL_TRIANGLES, body.buffers.index_count, GL_UNSIGNED_INT, nullptr);
-        }
-    for (auto& [key, garment] : garments)
-        if (garment.topology != nullptr) {
-            glBindVertexArray(garment.buffers.vao);
-            glDrawElements(GL_TRIANGLES, garment.buffers.index_count, GL_UNSIGNED_INT, nullptr);
-        }
+    for (const ReadyMesh& r : ready) {
+        if (!r.mesh->casts_shadow) continue;
+        glBindVertexArray(r.entry->buffers.vao);
+        glDrawElements(GL_TRIANGLES, r.entry->buffers.index_count, GL_UNSIGNED_INT, nullptr);
+    }
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
+}
 
-    // --- Bodies and garments ------------------------------------------------------------
+void Renderer::Impl::draw_lit_meshes(const FrameView& view) {
     glUseProgram(lit);
-    glUniformMatrix4fv(lit_u.view_projection, 1, GL_FALSE, view_projection.data());
+    glUniformMatrix4fv(lit_u.view_projection, 1, GL_FALSE, view.view_projection.data());
     const Mat4 identity = Mat4::Identity();
     const Mat3 identity3 = Mat3::Identity();
     glUniformMatrix4fv(lit_u.model, 1, GL_FALSE, identity.data());
     glUniformMatrix3fv(lit_u.normal_matrix, 1, GL_FALSE, identity3.data());
-    glUniform3fv(lit_u.eye, 1, eye.data());
-    glUniform1i(lit_u.two_sided, 0);
-    glUniform1f(lit_u.specular, 0.18f);
-    glUniform1f(lit_u.shininess, 24.0f);
-    glUniform1f(lit_u.rim, 0.25f);
-    for (auto& [key, body] : bodies) {
-        if (body.mesh == nullptr) continue;
-        glBindVertexArray(body.buffers.vao);
-        if (body.mesh->submeshes.empty()) {
-            glUniform4f(lit_u.color, 0.8f, 0.7f, 0.6f, 1.0f);
-            glDrawElements(GL_TRIANGLES, body.buffers.index_count, GL_UNSIGNED_INT, nullptr);
+    glUniform3fv(lit_u.eye, 1, view.eye.data());
+    for (const ReadyMesh& r : ready) {
+        const MeshDraw& mesh = *r.mesh;
+        glUniform1i(lit_u.two_sided, mesh.look.two_sided ? 1 : 0);
+        glUniform1f(lit_u.specular, mesh.look.specular);
+        glUniform1f(lit_u.shininess, mesh.look.shininess);
+        glUniform1f(lit_u.rim, mesh.look.rim);
+        glBindVertexArray(r.entry->buffers.vao);
+        if (mesh.ranges.empty()) {
+            const Vec3 c = clamp01(mesh.color);
+            glUniform4f(lit_u.color, c.x(), c.y(), c.z(), 1.0f);
+            glDrawElements(GL_TRIANGLES, r.entry->buffers.index_count, GL_UNSIGNED_INT, nullptr);
             continue;
         }
-        for (const Submesh& s : body.mesh->submeshes) {
-            const Vec3 c = s.color.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones());
+        for (const DrawRange& range : mesh.ranges) {
+            const Vec3 c = clamp01(range.color);
             glUniform4f(lit_u.color, c.x(), c.y(), c.z(), 1.0f);
-            glDrawElements(GL_TRIANGLES, GLsizei(s.index_count), GL_UNSIGNED_INT,
-                           reinterpret_cast<const void*>(std::uintptr_t(s.first_index) * sizeof(std::uint32_t)));
+            glDrawElements(GL_TRIANGLES, GLsizei(range.index_count), GL_UNSIGNED_INT,
+                           reinterpret_cast<const void*>(std::uintptr_t(range.first_index) * sizeof(std::uint32_t)));
         }
     }
-    glUniform1i(lit_u.two_sided, 1);
-    glUniform1f(lit_u.specular, 0.06f);
+}
+
+// Translucent, front faces only, no depth writes.
+void Renderer::Impl::draw_ellipsoids(const FrameView& view, const DrawList& list) {
+    if (!show_ellipsoids) return;
+    glUseProgram(lit);
+    glUniformMatrix4fv(lit_u.view_projection, 1, GL_FALSE, view.view_projection.data());
+    glUniform3fv(lit_u.eye, 1, view.eye.data());
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glUniform1i(lit_u.two_sided, 0);
+    glUniform1f(lit_u.specular, 0.3f);
     glUniform1f(lit_u.shininess, 12.0f);
     glUniform1f(lit_u.rim, 0.15f);
-    for (auto& [key, garment] : garments) {
-        if (garment.topology == nullptr) continue;
-        glUniform4f(lit_u.color, garment.color.x(), garment.color.y(), garment.color.z(), 1.0f);
-        glBindVertexArray(garment.buffers.vao);
-        glDrawElements(GL_TRIANGLES, garment.buffers.index_count, GL_UNSIGNED_INT, nullptr);
+    const Vec4& c = list.ellipsoid_color;
+    glUniform4f(lit_u.color, c.x(), c.y(), c.z(), c.w());
+    glBindVertexArray(sphere.vao);
+    for (const Affine3& world : list.ellipsoids) {
+        if (!world.matrix().allFinite() || std::abs(world.linear().determinant()) < Real(1e-12)) continue;
+        const Mat4 model = world.matrix();
+        const Mat3 normals = normal_matrix(world);
+        glUniformMatrix4fv(lit_u.model, 1, GL_FALSE, model.data());
+        glUniformMatrix3fv(lit_u.normal_matrix, 1, GL_FALSE, normals.data());
+        glDrawElements(GL_TRIANGLES, sphere.index_count, GL_UNSIGNED_INT, nullptr);
     }
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+}
 
-    // --- Translucent ellipsoids (front faces only, no depth writes) ----------------------
-    if (show_ellipsoids) {
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-        glDepthMask(GL_FALSE);
-        glEnable(GL_CULL_FACE);
-        glCullFace(GL_BACK);
-        glUniform1i(lit_u.two_sided, 0);
-        glUniform1f(lit_u.specular, 0.3f);
-        glUniform4f(lit_u.color, 0.15f, 0.75f, 0.95f, 0.32f);
-        glBindVertexArray(sphere.vao);
-        registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
-            if (!c.world.matrix().allFinite() || std::abs(c.world.linear().determinant()) < Real(1e-12)) return;
-            const Mat4 model = c.world.matrix();
-            const Mat3 normals = normal_matrix(c.world);
-            glUniformMatrix4fv(lit_u.model, 1, GL_FALSE, model.data());
-            glUniformMatrix3fv(lit_u.normal_matrix, 1, GL_FALSE, normals.data());
-            glDrawElements(GL_TRIANGLES, sphere.index_count, GL_UNSIGNED_INT, nullptr);
-        });
-        glDisable(GL_CULL_FACE);
-        glDisable(GL_BLEND);
-        glDepthMask(GL_TRUE);
-    }
+void Renderer::Impl::resolve() {
     glBindVertexArray(0);
-
-    // --- Resolve -------------------------------------------------------------------------
+    const GLsizei w = settings.width, h = settings.height;
     if (resolve_fbo != 0)
         glBlitNamedFramebuffer(draw_fbo, resolve_fbo, 0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     if (const GLenum error = glGetError(); error != GL_NO_ERROR)
@@ -540,7 +560,6 @@ void Renderer::Impl::draw(Registry& registry) {
             std::snprintf(buffer, sizeof buffer, "%04x", unsigned(error));
             return std::string(buffer);
         }() + " while drawing the frame");
-    drawn = true;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -594,12 +613,12 @@ int Renderer::height() const noexcept { return m_impl->settings.height; }
 void Renderer::set_show_ellipsoids(bool show) noexcept { m_impl->show_ellipsoids = show; }
 bool Renderer::show_ellipsoids() const noexcept { return m_impl->show_ellipsoids; }
 
-void Renderer::draw_scene(Registry& registry) {
+void Renderer::draw(const DrawList& list) {
     if (!m_impl->context->make_current()) {
         m_impl->frame_error = "EGL: cannot make the renderer's context current";
         return;
     }
-    m_impl->draw(registry);
+    m_impl->draw(list);
 }
 
 Result<void> Renderer::read_pixels(Image& into) {

@@ -6,6 +6,9 @@
 // Either way a frame is drawn into a framebuffer object (4x MSAA on a GPU), resolved,
 // then read back (`read_pixels`) or shown (`present`).
 //
+// The renderer draws what it is given (a DrawList of meshes and debug ellipsoids) and
+// knows nothing of the scene's components; systems/render_system.cpp builds the list.
+//
 // This header holds no EGL or GL type, so code outside engine/render builds the same with
 // or without the render module. One Renderer owns one context; it makes it current on the
 // calling thread before each GL call, so use a Renderer from one thread at a time.
@@ -16,8 +19,8 @@
 
 #include "engine/core/error.hpp"
 #include "engine/core/math.hpp"
-#include "engine/core/registry.hpp"
 #include "engine/render/camera.hpp"
+#include "engine/render/draw_list.hpp"
 #include "engine/render/image.hpp"
 #include "engine/render/input.hpp"
 
@@ -68,15 +71,16 @@ public:
     [[nodiscard]] int width() const noexcept;
     [[nodiscard]] int height() const noexcept;
 
+    /// Whether draw() shows a list's debug ellipsoids (the window's E key).
     void set_show_ellipsoids(bool show) noexcept;
     [[nodiscard]] bool show_ellipsoids() const noexcept;
 
-    /// Draws the registry's scene into the frame: every SkinnedMesh (lit, one colour per
-    /// submesh), every Garment (double-sided, normals from its particles), the ground with
-    /// contact shadows, and the EllipsoidColliders when shown. The render system calls this
-    /// once per frame. Bad data (an index past the vertices, a size mismatch) skips that
-    /// entity and is reported by the next read_pixels()/present().
-    void draw_scene(Registry& registry);
+    /// Draws a frame: the ground with the contact shadows of the meshes that ask for one,
+    /// planar shadows of the casters, the meshes lit in list order, and the list's
+    /// ellipsoids when shown. Bad data (an index past the vertices, a range past the
+    /// triangles) skips that mesh; it and the list's own problems are reported by the next
+    /// read_pixels()/present().
+    void draw(const DrawList& list);
 
     /// The last drawn frame, RGBA8, top row first. Also reports an error of the last draw.
     [[nodiscard]] Result<Image> read_pixels();

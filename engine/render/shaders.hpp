@@ -8,7 +8,7 @@
 
 namespace drape::render_detail {
 
-/// Lit surfaces: body, garment (two-sided), ellipsoids. Key + fill + hemisphere ambient.
+/// Lit surfaces: meshes (two-sided for cloth) and ellipsoids. Key + fill + hemisphere ambient.
 extern const char* const lit_vertex_shader;
 extern const char* const lit_fragment_shader;
 /// The ground plane (drawn from gl_VertexID, no buffer) with blob contact shadows and fog.

@@ -21,16 +21,16 @@ std::size_t triangles(const Submesh& s) { return s.index_count / 3; }
 
 }  // namespace
 
-CoverageReport rest_pose_coverage(const CharacterAsset& c, double tolerance_m) {
+CoverageReport rest_pose_coverage(const CharacterAsset& c, const CharacterBody& body, double tolerance_m) {
     std::vector<Affine3> global, skinning;
     compose_pose(*c.skeleton, c.skeleton->rest_local, global);
     skinning_matrices(*c.skeleton, global, skinning);
     Matrix3X positions, normals;
     skin_mesh(*c.mesh, skinning, Affine3::Identity(), positions, normals);
-    return measure_coverage(c.ellipsoids, global, positions, normals, tolerance_m);
+    return measure_coverage(body.ellipsoids, global, positions, normals, tolerance_m);
 }
 
-std::string character_report_text(const CharacterAsset& c, const CoverageReport& r) {
+std::string character_report_text(const CharacterAsset& c, const CharacterBody& body, const CoverageReport& r) {
     const SkeletonAsset& s = *c.skeleton;
     const MeshAsset& m = *c.mesh;
     std::string out = c.source.string() + "\n";
@@ -41,7 +41,7 @@ std::string character_report_text(const CharacterAsset& c, const CoverageReport&
                       i < m.submeshes.size() ? triangles(m.submeshes[i]) : std::size_t(0),
                       c.meshes[i].rigid ? "  (rigid, bound to its bone)" : "");
     out += format("  bones       %zu in the skeleton, %d move vertices; hips: %s\n", s.size(), c.skin_bones,
-                  c.hip_bone >= 0 ? s.bone_names[std::size_t(c.hip_bone)].c_str() : "none found");
+                  body.hip_bone >= 0 ? s.bone_names[std::size_t(body.hip_bone)].c_str() : "none found");
     out += format("  clips       %zu\n", c.clips.size());
     for (std::size_t i = 0; i < c.clips.size(); ++i) {
         const AnimationClip& clip = *c.clips[i];
@@ -49,9 +49,9 @@ std::string character_report_text(const CharacterAsset& c, const CoverageReport&
         if (clip.travel_m.norm() > 1e-3f) out += format("  travels %.2f m", double(clip.travel_m.norm()));
         out += "\n";
     }
-    out += format("  ellipsoids  %zu fitted\n", c.ellipsoids.size());
-    for (std::size_t i = 0; i < c.ellipsoids.size(); ++i) {
-        const EllipsoidShape& e = c.ellipsoids[i];
+    out += format("  ellipsoids  %zu fitted\n", body.ellipsoids.size());
+    for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {
+        const EllipsoidShape& e = body.ellipsoids[i];
         out += format("    %-20s %-10s radii %.3f %.3f %.3f m  bulge %.3f m\n", s.bone_names[std::size_t(e.bone)].c_str(),
                       body_region_name(e.region), double(e.radii_m.x()), double(e.radii_m.y()), double(e.radii_m.z()),
                       i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0);
@@ -62,7 +62,7 @@ std::string character_report_text(const CharacterAsset& c, const CoverageReport&
     return out;
 }
 
-std::string character_report_json(const CharacterAsset& c, const CoverageReport& r) {
+std::string character_report_json(const CharacterAsset& c, const CharacterBody& body, const CoverageReport& r) {
     using nlohmann::json;
     const SkeletonAsset& s = *c.skeleton;
     const MeshAsset& m = *c.mesh;
@@ -79,14 +79,14 @@ std::string character_report_json(const CharacterAsset& c, const CoverageReport&
                                {"triangles", i < m.submeshes.size() ? triangles(m.submeshes[i]) : 0}, {"rigid", c.meshes[i].rigid}});
     j["bones"] = s.size();
     j["skin_bones"] = c.skin_bones;
-    j["hip_bone"] = c.hip_bone >= 0 ? json(s.bone_names[std::size_t(c.hip_bone)]) : json(nullptr);
+    j["hip_bone"] = body.hip_bone >= 0 ? json(s.bone_names[std::size_t(body.hip_bone)]) : json(nullptr);
     j["clips"] = json::array();
     for (const auto& clip : c.clips)
         j["clips"].push_back({{"name", clip->name}, {"duration_s", clip->duration_s}, {"channels", clip->channels.size()},
                               {"travel_m", {clip->travel_m.x(), clip->travel_m.y(), clip->travel_m.z()}}});
     j["ellipsoids"] = json::array();
-    for (std::size_t i = 0; i < c.ellipsoids.size(); ++i) {
-        const EllipsoidShape& e = c.ellipsoids[i];
+    for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {
+        const EllipsoidShape& e = body.ellipsoids[i];
         j["ellipsoids"].push_back({{"bone", s.bone_names[std::size_t(e.bone)]},
                                    {"region", body_region_name(e.region)},
                                    {"center", {e.center.x(), e.center.y(), e.center.z()}},

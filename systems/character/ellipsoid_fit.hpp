@@ -20,10 +20,10 @@
 #include <string_view>
 #include <vector>
 
-#include "components/animation_player.hpp"
 #include "components/ellipsoid_collider.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
+#include "engine/assets/animation_clip.hpp"
+#include "engine/assets/mesh_asset.hpp"
+#include "engine/assets/skeleton_asset.hpp"
 #include "engine/core/error.hpp"
 #include "engine/core/math.hpp"
 

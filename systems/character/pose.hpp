@@ -4,15 +4,17 @@
 // translation and scale, slerp for rotation), compose them down the hierarchy (parents
 // come before children), form the skinning matrices global * inverse_bind, and blend
 // them per vertex (linear blend skinning). The systems in systems/*_system.cpp only
-// call these.
+// call these. Composing, skinning matrices and blending are plain transform math the
+// importer needs too (the rest pose's height); they live in engine/assets/skinning.hpp,
+// which this header includes.
 #pragma once
 
 #include <span>
 #include <vector>
 
-#include "components/animation_player.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
+#include "engine/assets/animation_clip.hpp"
+#include "engine/assets/skeleton_asset.hpp"
+#include "engine/assets/skinning.hpp"  // compose_pose, skinning_matrices, skin_mesh: the rest of a frame
 #include "engine/core/math.hpp"
 
 namespace drape {
@@ -37,25 +39,5 @@ void sample_clip(const AnimationClip& clip, const SkeletonAsset& skeleton, doubl
 
 /// The rest (node) pose.
 void rest_pose(const SkeletonAsset& skeleton, std::vector<Affine3>& local);
-
-/// Composes local transforms down the hierarchy into model space. Parents precede children.
-void compose_pose(const SkeletonAsset& skeleton, std::span<const Affine3> local, std::vector<Affine3>& global);
-
-/// global * inverse_bind per bone: bind model space -> current model space.
-void skinning_matrices(const SkeletonAsset& skeleton, std::span<const Affine3> global,
-                       std::vector<Affine3>& skinning);
-
-/// Linear blend skinning of every vertex: positions and normals in the space `to_space`
-/// maps model space to (the character's Transform for world space). Runs in parallel
-/// over blocks of vertices for big meshes. Outputs are resized.
-void skin_mesh(const MeshAsset& mesh, std::span<const Affine3> skinning, const Affine3& to_space,
-               Matrix3X& positions, Matrix3X& normals);
-
-/// The same for positions only (fitting, coverage, cloth pinning).
-void skin_positions(const MeshAsset& mesh, std::span<const Affine3> skinning, const Affine3& to_space,
-                    Matrix3X& positions);
-
-/// The rigid part of a transform (rotation and translation; scale and shear removed).
-[[nodiscard]] Affine3 rigid_part(const Affine3& transform) noexcept;
 
 }  // namespace drape

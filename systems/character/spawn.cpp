@@ -16,7 +16,7 @@
 namespace drape {
 
 Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const CharacterAsset> asset,
-                               const SpawnOptions& options) {
+                               const CharacterBody& body, const SpawnOptions& options) {
     if (!asset || !asset->skeleton || !asset->mesh) return fail("spawn_character: no character asset");
     const std::string at = asset->source.string() + ": ";
     const Transform& t = options.transform;
@@ -35,6 +35,9 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
         clip = asset->clips.front();
     }
     const int bones = static_cast<int>(asset->skeleton->size());
+    for (std::size_t i = 0; i < body.ellipsoids.size(); ++i)  // a body fitted to another character
+        if (body.ellipsoids[i].bone < 0 || body.ellipsoids[i].bone >= bones)
+            return fail(at + "body.ellipsoids[" + std::to_string(i) + "].bone: out of range");
     for (std::size_t i = 0; i < options.collider_overrides.size(); ++i) {
         const EllipsoidShape& s = options.collider_overrides[i];
         const std::string field = at + "colliders[" + std::to_string(i) + "]";
@@ -60,7 +63,7 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
     skin.mesh = asset->mesh;
     skin_mesh(*skin.mesh, skeleton.skinning, transform.matrix(), skin.positions, skin.normals);
 
-    for (const EllipsoidShape& s : apply_overrides(asset->ellipsoids, options.collider_overrides,
+    for (const EllipsoidShape& s : apply_overrides(body.ellipsoids, options.collider_overrides,
                                                    options.replace_fitted_colliders)) {
         const Entity c = registry.create();
         EllipsoidCollider collider;

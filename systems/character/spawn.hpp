@@ -11,6 +11,7 @@
 #include "engine/assets/character_asset.hpp"
 #include "engine/core/error.hpp"
 #include "engine/core/registry.hpp"
+#include "systems/character/character_body.hpp"
 
 namespace drape {
 
@@ -25,10 +26,12 @@ struct SpawnOptions {
     bool replace_fitted_colliders = false;           ///< Use only the overrides.
 };
 
-/// Creates the character and its colliders, posed at the start time and skinned, so
-/// they are valid before the first step. Errors name the character's file and the field.
+/// Creates the character and its colliders (the body's ellipsoids with the overrides
+/// applied), posed at the start time and skinned, so they are valid before the first
+/// step. `body` is fit_character_body(*asset) or one the caller made. Errors name the
+/// character's file and the field.
 [[nodiscard]] Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const CharacterAsset> asset,
-                                             const SpawnOptions& options = {});
+                                             const CharacterBody& body, const SpawnOptions& options = {});
 
 /// The collider entities of a character.
 [[nodiscard]] std::vector<Entity> colliders_of(Registry& registry, Entity character);

@@ -12,6 +12,7 @@
 #include "components/transform.hpp"
 #include "engine/assets/character_import.hpp"
 #include "engine/core/scheduler.hpp"
+#include "systems/character/character_body.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/pose.hpp"
 #include "systems/character/spawn.hpp"
@@ -28,6 +29,13 @@ std::shared_ptr<const CharacterAsset> column(const test::TestCharacter& spec = {
     std::filesystem::remove_all(dir);
     EXPECT_TRUE(r) << (r ? "" : r.error().message);
     return r ? *r : nullptr;
+}
+
+// The fitted body of a character (default fit options).
+CharacterBody body_of(const CharacterAsset& c) {
+    auto body = fit_character_body(c);
+    EXPECT_TRUE(body) << (body ? "" : body.error().message);
+    return body ? std::move(*body) : CharacterBody{};
 }
 
 Skeleton one_bone(const Affine3& global) {
@@ -98,19 +106,31 @@ TEST(EllipsoidColliders, AngularVelocityOfASpinningBone) {
 TEST(EllipsoidFitting, CoversTheTestColumnAndTagsNothingAsPelvis) {
     const auto c = column();
     ASSERT_TRUE(c);
-    ASSERT_FALSE(c->ellipsoids.empty());
+    const CharacterBody body = body_of(*c);
+    ASSERT_FALSE(body.ellipsoids.empty());
     std::vector<Affine3> global, skinning;
     compose_pose(*c->skeleton, c->skeleton->rest_local, global);
     skinning_matrices(*c->skeleton, global, skinning);
     Matrix3X p, n;
     skin_mesh(*c->mesh, skinning, Affine3::Identity(), p, n);
-    const CoverageReport r = measure_coverage(c->ellipsoids, global, p, n);
+    const CoverageReport r = measure_coverage(body.ellipsoids, global, p, n);
     EXPECT_GE(r.coverage, 0.95);
     EXPECT_EQ(find_hip_bone(*c->skeleton), -1);  // "Root" and "Child" are no hips
-    for (const EllipsoidShape& s : c->ellipsoids) {
+    EXPECT_EQ(body.hip_bone, -1);
+    for (const EllipsoidShape& s : body.ellipsoids) {
         EXPECT_TRUE(s.radii_m.allFinite());
         EXPECT_GT(s.radii_m.minCoeff(), 0);
     }
+}
+
+TEST(EllipsoidFitting, BadOptionsNameTheFileAndTheField) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    FitOptions bad;
+    bad.cluster_coverage = 0;
+    const auto body = fit_character_body(*c, bad);
+    ASSERT_FALSE(body);
+    EXPECT_EQ(body.error().message, c->source.string() + ": fit.cluster_coverage: must be in (0, 1]");
 }
 
 TEST(EllipsoidFitting, HipBoneIsFoundByNameOrByTheLegs) {
@@ -133,7 +153,7 @@ TEST(EllipsoidFitting, OverridesFromJsonReplaceTheFittedShapeOfTheirBone) {
     ASSERT_TRUE(o) << o.error().message;
     ASSERT_EQ(o->size(), 1u);
     EXPECT_EQ((*o)[0].region, BodyRegion::torso);
-    const auto merged = apply_overrides(c->ellipsoids, *o);
+    const auto merged = apply_overrides(body_of(*c).ellipsoids, *o);
     const int child = c->skeleton->find("Child");
     EXPECT_EQ(std::count_if(merged.begin(), merged.end(), [&](auto& s) { return s.bone == child; }), 1);
     EXPECT_TRUE(std::any_of(merged.begin(), merged.end(), [&](auto& s) { return s.radii_m.y() == 0.6f; }));
@@ -152,10 +172,11 @@ TEST(CharacterSystems, SpawnedCharacterAnimatesSkinsAndMovesItsColliders) {
     Registry registry;
     SpawnOptions options;
     options.transform.position = Vec3(3, 0, 0);
-    auto e = spawn_character(registry, c, options);
+    const CharacterBody body = body_of(*c);
+    auto e = spawn_character(registry, c, body, options);
     ASSERT_TRUE(e) << e.error().message;
     const auto colliders = colliders_of(registry, *e);
-    ASSERT_EQ(colliders.size(), c->ellipsoids.size());
+    ASSERT_EQ(colliders.size(), body.ellipsoids.size());
     // Valid at once: the skinned mesh is the rest mesh moved to x = 3.
     const SkinnedMesh& skin = registry.get<SkinnedMesh>(*e);
     EXPECT_NEAR(skin.positions.row(0).mean(), 3.0f, 1e-4f);
@@ -175,7 +196,7 @@ TEST(CharacterSystems, SpawnedCharacterAnimatesSkinsAndMovesItsColliders) {
     EXPECT_GT(moved.velocity_m_s.norm(), 0.0f);
     // The collider sits where its bone's pose says (in place: root travel removed).
     const Skeleton& skeleton = registry.get<Skeleton>(*e);
-    const EllipsoidShape& shape = *std::find_if(c->ellipsoids.begin(), c->ellipsoids.end(), [&](auto& s) { return s.bone == child; });
+    const EllipsoidShape& shape = *std::find_if(body.ellipsoids.begin(), body.ellipsoids.end(), [&](auto& s) { return s.bone == child; });
     const Affine3 expected = registry.get<Transform>(*e).matrix() * ellipsoid_transform(shape, skeleton.global[std::size_t(child)]);
     EXPECT_TRUE(moved.world.isApprox(expected, 1e-5f));
     EXPECT_NEAR(skeleton.global[0].translation().z(), 0.0f, 1e-5f);
@@ -190,9 +211,24 @@ TEST(CharacterSystems, SpawnRejectsAClipThatIsNotThere) {
     Registry registry;
     SpawnOptions options;
     options.clip = "Run";
-    auto e = spawn_character(registry, c, options);
+    auto e = spawn_character(registry, c, body_of(*c), options);
     ASSERT_FALSE(e);
     EXPECT_NE(e.error().message.find("no clip named 'Run'"), std::string::npos);
+    EXPECT_EQ(registry.alive(), 0u);
+}
+
+TEST(CharacterSystems, SpawnRejectsABodyWhoseBonesAreNotInTheSkeleton) {
+    const auto c = column();
+    ASSERT_TRUE(c);
+    Registry registry;
+    CharacterBody body = body_of(*c);
+    ASSERT_FALSE(body.ellipsoids.empty());
+    body.ellipsoids.back().bone = 99;  // as if fitted to a character with more bones
+    auto e = spawn_character(registry, c, body);
+    ASSERT_FALSE(e);
+    EXPECT_NE(e.error().message.find("body.ellipsoids[" + std::to_string(body.ellipsoids.size() - 1) + "].bone: out of range"),
+              std::string::npos)
+        << e.error().message;
     EXPECT_EQ(registry.alive(), 0u);
 }
 
@@ -206,7 +242,7 @@ TEST(CharacterSystems, ColliderOverridesReplaceOrAddAndAreValidated) {
     big.radii_m = Vec3(0.5f, 0.5f, 0.5f);
     options.collider_overrides = {big};
     options.replace_fitted_colliders = true;
-    auto e = spawn_character(registry, c, options);
+    auto e = spawn_character(registry, c, body_of(*c), options);
     ASSERT_TRUE(e) << e.error().message;
     const auto only = colliders_of(registry, *e);
     ASSERT_EQ(only.size(), 1u);
@@ -214,12 +250,12 @@ TEST(CharacterSystems, ColliderOverridesReplaceOrAddAndAreValidated) {
     EXPECT_FALSE(registry.get<EllipsoidCollider>(only[0]).initialised);  // velocities start with the first step
 
     options.collider_overrides[0].radii_m.y() = 0;
-    auto bad = spawn_character(registry, c, options);
+    auto bad = spawn_character(registry, c, body_of(*c), options);
     ASSERT_FALSE(bad);
     EXPECT_NE(bad.error().message.find("colliders[0].radii_m: must be > 0"), std::string::npos) << bad.error().message;
     options.collider_overrides[0].radii_m.y() = 0.5f;
     options.collider_overrides[0].bone = 99;
-    bad = spawn_character(registry, c, options);
+    bad = spawn_character(registry, c, body_of(*c), options);
     ASSERT_FALSE(bad);
     EXPECT_NE(bad.error().message.find("colliders[0].bone: out of range"), std::string::npos);
 }
@@ -230,7 +266,7 @@ TEST(CharacterSystems, CollidersOfAMovingCharacterCarryItsVelocity) {
     Registry registry;
     SpawnOptions options;
     options.speed = 0;  // hold the pose; only the Transform moves
-    auto e = spawn_character(registry, c, options);
+    auto e = spawn_character(registry, c, body_of(*c), options);
     ASSERT_TRUE(e);
     Scheduler scheduler;
     add_character_systems(scheduler);

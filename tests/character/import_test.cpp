@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "systems/character/character_body.hpp"
 #include "systems/character/pose.hpp"
 #include "tests/character/test_character_file.hpp"
 
@@ -128,9 +129,6 @@ TEST(CharacterImport, OptionsAreValidatedWithTheFieldName) {
     bad.scale = -1;
     ASSERT_FALSE(validate(bad));
     EXPECT_NE(validate(bad).error().message.find("scale"), std::string::npos);
-    bad = {};
-    bad.fit.cluster_coverage = 0;
-    EXPECT_NE(validate(bad).error().message.find("fit.cluster_coverage"), std::string::npos);
 }
 
 // Bones skinning or fitting cannot use are errors naming the file and the bone; unweighted
@@ -169,7 +167,9 @@ TEST_F(BoneCheck, UnweightedZeroLengthEndBoneLoadsWithAWarning) {
     ASSERT_EQ((*r)->warnings.size(), 1u);
     EXPECT_EQ((*r)->warnings[0], file() + ": 1 zero-length end bone without skinned vertices, ignored: 'ChildEnd'");
     EXPECT_TRUE((*r)->mesh->bind_positions.allFinite());
-    for (const EllipsoidShape& e : (*r)->ellipsoids) EXPECT_TRUE(e.radii_m.allFinite() && e.radii_m.minCoeff() > 0);
+    const auto body = fit_character_body(**r);
+    ASSERT_TRUE(body) << body.error().message;
+    for (const EllipsoidShape& e : body->ellipsoids) EXPECT_TRUE(e.radii_m.allFinite() && e.radii_m.minCoeff() > 0);
 }
 
 TEST_F(BoneCheck, UnweightedEndBoneWithAZeroScaleBindLoadsWithAWarning) {

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "engine/assets/character_import.hpp"
+#include "systems/character/character_body.hpp"
 #include "systems/character/pose.hpp"
 
 namespace drape {
@@ -49,21 +50,24 @@ TEST_P(SharedCharacter, ImportsWithClipsBonesNormalisedWeightsAndCoveringEllipso
 
     EXPECT_GE(c.height_m, e.human ? 1.5f : 0.1f);
     EXPECT_LE(c.height_m, e.human ? 2.0f : 3.0f);
-    ASSERT_FALSE(c.ellipsoids.empty());
+    const auto fitted = fit_character_body(c);
+    ASSERT_TRUE(fitted) << fitted.error().message;
+    const CharacterBody& body = *fitted;
+    ASSERT_FALSE(body.ellipsoids.empty());
     std::vector<Affine3> global, skinning;
     compose_pose(*c.skeleton, c.skeleton->rest_local, global);
     skinning_matrices(*c.skeleton, global, skinning);
     Matrix3X p, n;
     skin_mesh(m, skinning, Affine3::Identity(), p, n);
-    const CoverageReport report = measure_coverage(c.ellipsoids, global, p, n);
+    const CoverageReport report = measure_coverage(body.ellipsoids, global, p, n);
     EXPECT_GE(report.coverage, 0.95) << e.file;
     if (e.human) {
-        EXPECT_GE(c.ellipsoids.size(), 10u);
-        EXPECT_LE(c.ellipsoids.size(), 20u);
-        EXPECT_GE(c.hip_bone, 0);
-        EXPECT_TRUE(std::any_of(c.ellipsoids.begin(), c.ellipsoids.end(), [](auto& s) { return s.region == BodyRegion::pelvis; }));
+        EXPECT_GE(body.ellipsoids.size(), 10u);
+        EXPECT_LE(body.ellipsoids.size(), 20u);
+        EXPECT_GE(body.hip_bone, 0);
+        EXPECT_TRUE(std::any_of(body.ellipsoids.begin(), body.ellipsoids.end(), [](auto& s) { return s.region == BodyRegion::pelvis; }));
         // One ellipsoid per hand and per foot: fingers merge, left and right do not.
-        auto count = [&](BodyRegion r) { return std::count_if(c.ellipsoids.begin(), c.ellipsoids.end(), [&](auto& s) { return s.region == r; }); };
+        auto count = [&](BodyRegion r) { return std::count_if(body.ellipsoids.begin(), body.ellipsoids.end(), [&](auto& s) { return s.region == r; }); };
         EXPECT_EQ(count(BodyRegion::hand), 2);
         EXPECT_EQ(count(BodyRegion::foot), 2);
         EXPECT_EQ(count(BodyRegion::upper_leg), 2);

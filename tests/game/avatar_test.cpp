@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "engine/assets/character_import.hpp"
+#include "systems/character/character_body.hpp"
 #include "systems/character/character_report.hpp"
 #include "systems/character/pose.hpp"
 
@@ -267,16 +268,20 @@ TEST(DefaultAvatar, ImportsLikeAnyCharacter) {
         EXPECT_TRUE(channel.rotations.front().coeffs().isApprox(channel.rotations.back().coeffs(), 1e-6f))
             << c.skeleton->bone_names[std::size_t(channel.bone)];
     }
-    EXPECT_EQ(c.hip_bone, c.skeleton->find("Hips"));
+    const auto body = fit_character_body(c);
+    ASSERT_TRUE(body) << body.error().message;
+    EXPECT_EQ(body->hip_bone, c.skeleton->find("Hips"));
 }
 
 TEST(DefaultAvatar, FittedEllipsoidsCoverTheBody) {
     const auto imported = import_character(committed_avatar);
     ASSERT_TRUE(imported) << imported.error().message;
     const CharacterAsset& c = **imported;
-    EXPECT_GE(c.ellipsoids.size(), 12u);
-    EXPECT_LE(c.ellipsoids.size(), 22u);
-    const CoverageReport coverage = rest_pose_coverage(c);
+    const auto body = fit_character_body(c);
+    ASSERT_TRUE(body) << body.error().message;
+    EXPECT_GE(body->ellipsoids.size(), 12u);
+    EXPECT_LE(body->ellipsoids.size(), 22u);
+    const CoverageReport coverage = rest_pose_coverage(c, *body);
     EXPECT_GE(coverage.coverage, 0.95) << "max gap " << coverage.max_gap_m << " m";
 }
 

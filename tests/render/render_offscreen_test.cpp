@@ -68,7 +68,7 @@ struct Scene {
 };
 
 Image render(Renderer& renderer, Registry& registry) {
-    renderer.draw_scene(registry);
+    draw_registry(renderer, registry);
     auto image = renderer.read_pixels();
     EXPECT_TRUE(image.has_value()) << (image ? "" : image.error().message);
     return image ? std::move(*image) : Image{};
@@ -265,13 +265,13 @@ TEST(RenderOffscreen, BadGarmentIndicesAreReportedNotDrawn) {
     auto topology = std::make_shared<Fabric>(*scene.registry.get<Garment>(scene.garment).fabric);
     topology->triangles[7] = 100000;
     scene.registry.get<Garment>(scene.garment).fabric = topology;
-    renderer->draw_scene(scene.registry);
+    draw_registry(*renderer, scene.registry);
     auto image = renderer->read_pixels();
     ASSERT_FALSE(image.has_value());
     EXPECT_NE(image.error().message.find("triangles[7] = 100000"), std::string::npos) << image.error().message;
     // Once fixed, the next frame is fine again.
     topology->triangles[7] = 0;
-    renderer->draw_scene(scene.registry);
+    draw_registry(*renderer, scene.registry);
     EXPECT_TRUE(renderer->read_pixels().has_value());
 }
 
@@ -281,7 +281,7 @@ TEST(RenderOffscreen, SkinnedPositionsNotMatchingTheMeshAreReported) {
     Scene scene;
     auto& skin = scene.registry.get<SkinnedMesh>(scene.body);
     skin.positions.conservativeResize(3, skin.positions.cols() - 1);
-    renderer->draw_scene(scene.registry);
+    draw_registry(*renderer, scene.registry);
     auto image = renderer->read_pixels();
     ASSERT_FALSE(image.has_value());
     EXPECT_NE(image.error().message.find("skinned positions"), std::string::npos) << image.error().message;

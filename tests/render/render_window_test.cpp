@@ -159,7 +159,7 @@ TEST(RenderWindow, OneFrameRendersInAnXvfbWindowAndReadsBack) {
 
     InputState input;
     EXPECT_TRUE(renderer.poll_events(input));
-    renderer.draw_scene(registry);
+    draw_registry(renderer, registry);
     ASSERT_TRUE(renderer.present().has_value());
     auto image = renderer.read_pixels();
     ASSERT_TRUE(image.has_value()) << image.error().message;

@@ -1,0 +1,16 @@
+// Fitting a character's body: see character_body.hpp.
+#include "systems/character/character_body.hpp"
+
+namespace drape {
+
+Result<CharacterBody> fit_character_body(const CharacterAsset& character, const FitOptions& options) {
+    const std::string at = character.source.string() + ": ";
+    if (auto ok = validate(options); !ok) return fail(at + ok.error().message);
+    if (!character.skeleton || !character.mesh) return fail(at + "no skeleton or mesh to fit a body to");
+    CharacterBody body;
+    body.hip_bone = find_hip_bone(*character.skeleton);
+    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips);
+    return body;
+}
+
+}  // namespace drape

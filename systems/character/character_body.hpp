@@ -1,0 +1,28 @@
+// What Drape derives from an imported character for its garments (method §2): ellipsoids
+// fitted to the skin, which the cloth collides with, and the pelvis bone the skirt
+// builder finds the waist from. The importer (engine/assets/character_import.hpp)
+// returns the file's data only; a scene fits the body once per character file and spawns
+// every instance of that character with it (spawn.hpp).
+#pragma once
+
+#include <vector>
+
+#include "components/ellipsoid_collider.hpp"
+#include "engine/assets/character_asset.hpp"
+#include "engine/core/error.hpp"
+#include "systems/character/ellipsoid_fit.hpp"
+
+namespace drape {
+
+/// A character's collision body, in bone space; shared by every instance of the character.
+struct CharacterBody {
+    std::vector<EllipsoidShape> ellipsoids;  ///< Fitted, bone space: bone, center, rotation, radii_m.
+    int hip_bone = -1;                       ///< find_hip_bone(); -1 when none.
+};
+
+/// Fits the body of an imported character: find_hip_bone() on its skeleton and
+/// fit_ellipsoids() on its bind mesh, rest height and clips. The error (bad options, no
+/// skeleton or mesh) names the character's file and the field.
+[[nodiscard]] Result<CharacterBody> fit_character_body(const CharacterAsset& character, const FitOptions& options = {});
+
+}  // namespace drape
