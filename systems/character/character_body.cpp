@@ -9,7 +9,7 @@ Result<CharacterBody> fit_character_body(const CharacterAsset& character, const 
     if (!character.skeleton || !character.mesh) return fail(at + "no skeleton or mesh to fit a body to");
     CharacterBody body;
     body.hip_bone = find_hip_bone(*character.skeleton);
-    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips);
+    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips, character.meshes);
     return body;
 }
 

@@ -27,7 +27,7 @@ CoverageReport rest_pose_coverage(const CharacterAsset& c, const CharacterBody& 
     skinning_matrices(*c.skeleton, global, skinning);
     Matrix3X positions, normals;
     skin_mesh(*c.mesh, skinning, Affine3::Identity(), positions, normals);
-    return measure_coverage(body.ellipsoids, global, positions, normals, tolerance_m);
+    return measure_coverage(body.ellipsoids, global, positions, normals, c.mesh->indices, tolerance_m);
 }
 
 std::string character_report_text(const CharacterAsset& c, const CharacterBody& body, const CoverageReport& r) {
@@ -58,7 +58,8 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
     }
     out += format("  coverage    %.1f %% of %zu vertices inside or within %.0f mm (largest gap %.3f m)\n", 100 * r.coverage,
                   r.vertices, 1000 * r.tolerance_m, r.max_gap_m);
-    out += format("  bulge       mean %.3f m, p95 %.3f m, max %.3f m out of the body\n", r.mean_bulge_m, r.p95_bulge_m, r.max_bulge_m);
+    out += format("  bulge       %.0f %% of the ellipsoids' outer surface stands out of the skin: mean %.3f m, p95 %.3f m, max %.3f m\n",
+                  100 * r.outside_share, r.mean_bulge_m, r.p95_bulge_m, r.max_bulge_m);
     return out;
 }
 
@@ -94,8 +95,9 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
                                    {"radii_m", {e.radii_m.x(), e.radii_m.y(), e.radii_m.z()}},
                                    {"bulge_m", i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0}});
     }
-    j["coverage"] = {{"share", r.coverage}, {"vertices", r.vertices}, {"covered", r.covered}, {"tolerance_m", r.tolerance_m},
-                     {"max_gap_m", r.max_gap_m}, {"mean_bulge_m", r.mean_bulge_m}, {"p95_bulge_m", r.p95_bulge_m},
+    j["coverage"] = {{"share", r.coverage},           {"vertices", r.vertices},         {"covered", r.covered},
+                     {"tolerance_m", r.tolerance_m},   {"max_gap_m", r.max_gap_m},       {"surface_m2", r.surface_m2},
+                     {"outside_share", r.outside_share}, {"mean_bulge_m", r.mean_bulge_m}, {"p95_bulge_m", r.p95_bulge_m},
                      {"max_bulge_m", r.max_bulge_m}};
     return j.dump(2) + "\n";
 }
