@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -707,6 +708,82 @@ Result<std::size_t> find_clip(const CharacterAsset& character, std::string_view 
     if (character.clips.size() > 20) names += ", ...";
     return fail(where(character.source) + ": no clip named '" + std::string(name_or_index) + "' (clips: " +
                 (names.empty() ? "none" : names) + ")");
+}
+
+namespace {
+
+// The words of a clip name after its armature prefix ("HumanArmature|Man_Walk" -> man, walk;
+// "WalkJump" -> walk, jump), lower case.
+std::vector<std::string> clip_words(std::string_view name) {
+    if (const auto bar = name.rfind('|'); bar != std::string_view::npos) name.remove_prefix(bar + 1);
+    std::vector<std::string> words;
+    std::string word;
+    for (std::size_t i = 0; i < name.size(); ++i) {
+        const char c = name[i];
+        const bool letter = std::isalpha(static_cast<unsigned char>(c)) != 0;
+        const bool upper_after_lower = letter && std::isupper(static_cast<unsigned char>(c)) && i > 0 &&
+                                       std::islower(static_cast<unsigned char>(name[i - 1]));
+        if (!letter || upper_after_lower) {
+            if (!word.empty()) words.push_back(word);
+            word.clear();
+        }
+        if (letter) word += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+    if (!word.empty()) words.push_back(word);
+    return words;
+}
+
+// The first of `stems` (in their order) that starts one of the words, or empty.
+std::string says(const std::vector<std::string>& words, std::initializer_list<std::string_view> stems) {
+    for (std::string_view stem : stems)
+        for (const std::string& w : words)
+            if (w.rfind(stem, 0) == 0) return std::string(stem);
+    return {};
+}
+
+// Every channel's last rotation key within about 6 degrees of its first: the clip loops.
+bool loops(const AnimationClip& clip) {
+    for (const BoneChannel& ch : clip.channels)
+        if (ch.rotations.size() >= 2 && ch.rotations.front().angularDistance(ch.rotations.back()) > Real(0.1)) return false;
+    return !clip.channels.empty();
+}
+
+}  // namespace
+
+std::optional<ClipChoice> choose_default_clip(const CharacterAsset& character) {
+    if (character.clips.empty()) return std::nullopt;
+    // Words that name another action than the one looked for ("WalkJump", "Walk_Back").
+    const std::initializer_list<std::string_view> other_actions = {
+        "jump", "turn", "back", "strafe", "crouch", "stop", "start", "death", "die", "punch", "attack", "sit", "injur", "limp"};
+    struct Kind {
+        std::initializer_list<std::string_view> stems;
+        bool must_loop;
+        const char* why;
+    };
+    const Kind kinds[] = {{{"walk"}, false, "name says "},
+                          {{"run", "jog", "step", "stride", "march", "locomotion"}, true, "looping locomotion: name says "},
+                          {{"idle", "breath"}, false, "no walk or locomotion clip; name says "}};
+    for (const Kind& kind : kinds) {
+        std::optional<std::size_t> best;
+        int best_rank = 0;
+        std::string best_word;
+        for (std::size_t i = 0; i < character.clips.size(); ++i) {
+            const AnimationClip& clip = *character.clips[i];
+            const std::vector<std::string> words = clip_words(clip.name);
+            const std::string word = says(words, kind.stems);
+            if (word.empty()) continue;
+            const bool looping = loops(clip);
+            if (kind.must_loop && !looping) continue;
+            const int rank = (says(words, other_actions).empty() ? 2 : 0) + (looping ? 1 : 0);
+            if (!best || rank > best_rank) {
+                best = i;
+                best_rank = rank;
+                best_word = word;
+            }
+        }
+        if (best) return ClipChoice{*best, character.clips[*best]->name + " (" + kind.why + best_word + ")"};
+    }
+    return ClipChoice{0, character.clips[0]->name + " (first clip: no walk, locomotion or idle clip)"};
 }
 
 }  // namespace drape

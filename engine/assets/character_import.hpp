@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "engine/assets/character_asset.hpp"
@@ -53,6 +54,20 @@ struct ImportOptions {
 /// A clip by exact name, else by the part after the last '|' when unique ("Man_Walk" for
 /// "HumanArmature|Man_Walk"), else by index ("0", "3"). The error lists the clips there are.
 [[nodiscard]] Result<std::size_t> find_clip(const CharacterAsset& character, std::string_view name_or_index);
+
+/// The clip played when none is named, and why (for logs and `drape inspect`).
+struct ClipChoice {
+    std::size_t index = 0;
+    std::string reason;  ///< e.g. "Walking (name says walk)".
+};
+
+/// Picks the clip to play when none is named: a clip whose name says walk; else a looping
+/// locomotion clip (name says run, jog, step, stride, march or locomotion); else an idle
+/// (name says idle or breath); else clip 0. A name is read as words ("Man_Walk",
+/// "WalkJump" and "walk-cycle" all say walk); among several walks, one whose name names no
+/// other action (jump, turn, back, ...) wins, then one that loops, then the first. A clip
+/// loops when every channel's last rotation key matches its first. nullopt: no clips.
+[[nodiscard]] std::optional<ClipChoice> choose_default_clip(const CharacterAsset& character);
 
 /// The clip's motion bone and travel (AnimationClip::motion_bone, travel_m, travel_local)
 /// from its keys and the skeleton's rest pose.

@@ -31,8 +31,8 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
         auto index = find_clip(*asset, options.clip);
         if (!index) return std::unexpected(index.error());
         clip = asset->clips[*index];
-    } else if (!asset->clips.empty()) {
-        clip = asset->clips.front();
+    } else if (const auto choice = choose_default_clip(*asset)) {
+        clip = asset->clips[choice->index];
     }
     const int bones = static_cast<int>(asset->skeleton->size());
     for (std::size_t i = 0; i < body.ellipsoids.size(); ++i)  // a body fitted to another character

@@ -17,7 +17,7 @@ namespace drape {
 
 struct SpawnOptions {
     Transform transform;
-    std::string clip;                  ///< Name or index; empty = the first clip (none: rest pose).
+    std::string clip;                  ///< Name or index; empty = choose_default_clip() (a walk when there is one; no clips: rest pose).
     double speed = 1;                  ///< Playback rate.
     bool loop = true;
     bool in_place = true;              ///< false: root motion moves the Transform.

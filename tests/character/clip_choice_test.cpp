@@ -1,0 +1,100 @@
+// The clip a character plays when none is named: a walk, else a looping run or other
+// locomotion, else an idle, else the first clip; spawning without a clip plays it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "components/animation_player.hpp"
+#include "engine/assets/character_import.hpp"
+#include "systems/character/character_body.hpp"
+#include "systems/character/spawn.hpp"
+#include "tests/character/test_character_file.hpp"
+
+namespace drape {
+namespace {
+
+// A clip on bone 0 whose last rotation key is `turn_rad` from its first (0: it loops).
+std::shared_ptr<const AnimationClip> clip(const std::string& name, float turn_rad = 0) {
+    auto c = std::make_shared<AnimationClip>();
+    c->name = name;
+    c->duration_s = 1;
+    BoneChannel ch;
+    ch.bone = 0;
+    ch.rotation_times_s = {0, 0.5f, 1};
+    ch.rotations = {Quat::Identity(), Quat(Eigen::AngleAxis<Real>(0.5f, Vec3::UnitY())),
+                    Quat(Eigen::AngleAxis<Real>(turn_rad, Vec3::UnitY()))};
+    c->channels.push_back(ch);
+    return c;
+}
+
+CharacterAsset with_clips(std::vector<std::shared_ptr<const AnimationClip>> clips) {
+    CharacterAsset c;
+    c.source = "test.glb";
+    c.clips = std::move(clips);
+    return c;
+}
+
+std::string chosen(const CharacterAsset& c) {
+    const auto choice = choose_default_clip(c);
+    return choice ? c.clips[choice->index]->name : "none";
+}
+
+TEST(DefaultClip, AWalkWinsWhereverItIs) {
+    const CharacterAsset c = with_clips({clip("HumanArmature|Man_Clapping"), clip("HumanArmature|Man_Run"), clip("HumanArmature|Man_Walk")});
+    const auto choice = choose_default_clip(c);
+    ASSERT_TRUE(choice);
+    EXPECT_EQ(choice->index, 2u);
+    EXPECT_EQ(choice->reason, "HumanArmature|Man_Walk (name says walk)");
+}
+
+TEST(DefaultClip, AWalkNamingNoOtherActionBeatsOneThatDoes) {
+    EXPECT_EQ(chosen(with_clips({clip("WalkJump"), clip("Walking")})), "Walking");
+    EXPECT_EQ(chosen(with_clips({clip("Walk_Back"), clip("walk-cycle")})), "walk-cycle");
+    // Among equals, one that loops, then the first.
+    EXPECT_EQ(chosen(with_clips({clip("Walk_A", 1.0f), clip("Walk_B")})), "Walk_B");
+    EXPECT_EQ(chosen(with_clips({clip("Walk_A"), clip("Walk_B")})), "Walk_A");
+}
+
+TEST(DefaultClip, WithoutAWalkALoopingLocomotionClip) {
+    const CharacterAsset c = with_clips({clip("Clapping"), clip("Sprint_Stop", 1.0f), clip("RunningJump"), clip("Run")});
+    const auto choice = choose_default_clip(c);
+    ASSERT_TRUE(choice);
+    EXPECT_EQ(c.clips[choice->index]->name, "Run");
+    EXPECT_EQ(choice->reason, "Run (looping locomotion: name says run)");
+    // A run that does not loop is no locomotion cycle: the idle wins.
+    EXPECT_EQ(chosen(with_clips({clip("Jog", 1.0f), clip("Idle")})), "Idle");
+}
+
+TEST(DefaultClip, ThenAnIdleThenTheFirstClip) {
+    const CharacterAsset idle = with_clips({clip("Wave"), clip("Breathing_Idle")});
+    EXPECT_EQ(choose_default_clip(idle)->reason, "Breathing_Idle (no walk or locomotion clip; name says idle)");
+    const CharacterAsset none = with_clips({clip("Wave"), clip("Punch")});
+    EXPECT_EQ(choose_default_clip(none)->index, 0u);
+    EXPECT_EQ(choose_default_clip(none)->reason, "Wave (first clip: no walk, locomotion or idle clip)");
+    EXPECT_FALSE(choose_default_clip(with_clips({})));
+}
+
+TEST(DefaultClip, SpawnWithoutAClipPlaysTheChoice) {
+    const auto dir = test::temp_dir("clip_choice");
+    test::write_test_character({}, dir / "column.gltf");
+    auto imported = import_character(dir / "column.gltf");
+    std::filesystem::remove_all(dir);
+    ASSERT_TRUE(imported) << imported.error().message;
+    auto asset = std::make_shared<CharacterAsset>(**imported);
+    asset->clips = {(*imported)->clips.front(), clip("Walk")};  // "Bend" first, then a walk
+    const auto body = fit_character_body(*asset);
+    ASSERT_TRUE(body) << body.error().message;
+    Registry registry;
+    auto e = spawn_character(registry, asset, *body);
+    ASSERT_TRUE(e) << e.error().message;
+    ASSERT_TRUE(registry.get<AnimationPlayer>(*e).clip);
+    EXPECT_EQ(registry.get<AnimationPlayer>(*e).clip->name, "Walk");
+    SpawnOptions named;
+    named.clip = "Bend";
+    auto f = spawn_character(registry, asset, *body, named);
+    ASSERT_TRUE(f) << f.error().message;
+    EXPECT_EQ(registry.get<AnimationPlayer>(*f).clip->name, "Bend");
+}
+
+}  // namespace
+}  // namespace drape
