@@ -88,10 +88,9 @@ void grid_for(int particles, int default_lines, int default_rows, int stride, in
     rows = std::min(rows, max_garment_particles / lines);  // rounding must not pass the builders' limit
 }
 
-// Scene parameters onto the builder's parameter struct (SkirtParams or DressParams).
-template <class Params>
-void apply_parameters(Params& p, const GarmentDescription& g, std::string_view ring_fraction, std::string_view ring_height,
-                      Real Params::*fraction_field, Real Params::*height_field) {
+// Scene parameters onto the builder's parameters (`defaults`: the garment type's).
+void apply_parameters(TubeParams& p, const TubeParams& defaults, const GarmentDescription& g, std::string_view ring_fraction,
+                      std::string_view ring_height) {
     std::optional<int> particles;
     for (const GarmentParameter& q : g.parameters) {
         const Real r = static_cast<Real>(q.value);
@@ -104,8 +103,8 @@ void apply_parameters(Params& p, const GarmentDescription& g, std::string_view r
         else if (n == "length_m") p.length_m = r;
         else if (n == "flare_deg") p.flare_deg = r;
         else if (n == "ease_m") p.ease_m = r;
-        else if (n == ring_fraction) p.*fraction_field = r;
-        else if (n == ring_height) p.*height_field = r;
+        else if (n == ring_fraction) p.ring_height_fraction = r;
+        else if (n == ring_height) p.ring_height_m = r;
         else if (n == "torso_radius_fraction") p.torso_radius_fraction = r;
         else if (n == "fitting_rows") p.fitting_rows = i;
         else if (n == "mass_kg") p.material.mass_kg = r;
@@ -117,7 +116,7 @@ void apply_parameters(Params& p, const GarmentDescription& g, std::string_view r
         else if (n == "strain_iterations") p.material.strain_iterations = i;
         else if (n == "candidate_margin_m") p.material.candidate_margin_m = r;
     }
-    if (particles) grid_for(*particles, Params{}.warp_lines, Params{}.particles_per_line, p.weft_stride, p.warp_lines, p.particles_per_line);
+    if (particles) grid_for(*particles, defaults.warp_lines, defaults.particles_per_line, p.weft_stride, p.warp_lines, p.particles_per_line);
     p.model = g.model;
     p.collision = g.collision;
     if (g.color) p.color = *g.color;
@@ -280,14 +279,12 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         const Entity body = world.characters.at(static_cast<std::size_t>(g.character));
         Result<Entity> garment = fail("");
         if (g.type == GarmentType::skirt) {
-            SkirtParams p;
-            apply_parameters(p, g, "waist_height_fraction", "waist_height_m", &SkirtParams::waist_height_fraction,
-                             &SkirtParams::waist_height_m);
+            TubeParams p = TubeParams::skirt();
+            apply_parameters(p, TubeParams::skirt(), g, "waist_height_fraction", "waist_height_m");
             garment = attach_skirt(world.registry, body, p);
         } else {
-            DressParams p;
-            apply_parameters(p, g, "shoulder_height_fraction", "shoulder_height_m", &DressParams::shoulder_height_fraction,
-                             &DressParams::shoulder_height_m);
+            TubeParams p = TubeParams::dress();
+            apply_parameters(p, TubeParams::dress(), g, "shoulder_height_fraction", "shoulder_height_m");
             garment = attach_dress(world.registry, body, p);
         }
         if (!garment) return fail(located(g.where, field, garment.error().message));

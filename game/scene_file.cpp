@@ -579,8 +579,8 @@ OrderedJson vec(const Vec3& v) { return OrderedJson::array({v.x(), v.y(), v.z()}
 }  // namespace
 
 const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type) {
-    // Mirrors SkirtParams, DressParams and ClothMaterial (systems/cloth/garment_builder.hpp,
-    // components/garment.hpp). The builder checks the combinations (validate(SkirtParams)).
+    // Mirrors TubeParams and ClothMaterial (systems/cloth/garment_builder.hpp,
+    // components/garment.hpp). The builder checks the combinations (validate(TubeParams)).
     auto shared = [](std::string_view ring_fraction, std::string_view ring_height) {
         return std::vector<GarmentParameterSpec>{
             {"particles", 16, max_scene_particles, false, true, "target particle count; sets warp_lines and particles_per_line"},

@@ -63,8 +63,8 @@ enum class GarmentType : std::uint8_t { skirt, dress };
 [[nodiscard]] const char* cloth_model_name(ClothModel m) noexcept;
 [[nodiscard]] const char* collision_mode_name(CollisionMode m) noexcept;
 
-/// One numeric garment parameter set in a scene (the name is a field of SkirtParams or
-/// DressParams; see garment_parameters()).
+/// One numeric garment parameter set in a scene (the name is a field of TubeParams or
+/// its ClothMaterial; see garment_parameters()).
 struct GarmentParameter {
     std::string name;
     double value = 0;
@@ -130,7 +130,7 @@ struct SceneDescription {
 
 /// A numeric garment parameter a scene may set: its name, range and meaning.
 struct GarmentParameterSpec {
-    std::string_view name;               ///< A field of SkirtParams / DressParams / ClothMaterial, or "particles".
+    std::string_view name;               ///< A field of TubeParams / ClothMaterial, or "particles".
     double min, max;                     ///< Range; max inclusive.
     bool min_exclusive;                  ///< true: (min, max]; false: [min, max].
     bool integer;

@@ -113,17 +113,6 @@ Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     return (-b + std::sqrt(disc)) / (2 * a);
 }
 
-struct TubeShape {
-    std::string_view name;
-    int lines, per_line, stride;
-    Real length_m, flare_rad, ease_m, height_fraction, height_m, torso_fraction;
-    int fitting_rows;
-    ClothMaterial material;
-    ClothModel model;
-    CollisionMode collision;
-    Vec3 color;
-};
-
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
                     std::span<const EllipsoidFrame> frames, std::uint32_t p, const Vec3& x) {
@@ -226,8 +215,8 @@ Result<Entity> finish(Registry& registry, Garment g, int rows) {
     return e;
 }
 
-Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape& s) {
-    const std::string p(s.name);
+Result<Entity> attach_tube(Registry& registry, Entity character, std::string_view name, const TubeParams& s) {
+    const std::string p(name);
     if (!registry.valid(character)) return fail(p + ": the character entity is not alive");
     const std::vector<Entity> colliders = character_colliders(registry, character);
     if (colliders.empty()) return fail(p + ": the character has no ellipsoid colliders");
@@ -256,7 +245,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
     if (active == 0) return fail(p + ": the character's colliders are degenerate (zero radii)");
     axis /= Real(active);
     const Real height = top - bottom;
-    const Real ring_y = bottom + (s.height_m > 0 ? s.height_m : s.height_fraction * height);
+    const Real ring_y = bottom + (s.ring_height_m > 0 ? s.ring_height_m : s.ring_height_fraction * height);
     const Vec3 origin(axis.x(), ring_y, axis.z());
 
     // Outline colliders: cross the ring height, near the axis.
@@ -265,13 +254,14 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
         const EllipsoidFrame& f = frames[e];
         if (!f.active || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
         const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
-        if (off.norm() > s.torso_fraction * height) continue;
+        if (off.norm() > s.torso_radius_fraction * height) continue;
         outline.push_back(e);
     }
     if (outline.empty())
         return fail(p + ": no collider crosses the ring height " + number(ring_y) + " m near the body axis");
 
-    const int n = s.lines, m = s.per_line;
+    const int n = s.warp_lines, m = s.particles_per_line;
+    const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;
     const Real step = s.length_m / Real(m - 1);
     Matrix3X grid(3, n * m);
     for (int line = 0; line < n; ++line) {
@@ -284,10 +274,10 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
         for (int row = 0; row < m; ++row) {
             const Real along = step * Real(row);
             grid.col(line * m + row) =
-                origin + d * (r + along * std::sin(s.flare_rad)) - Vec3::UnitY() * (along * std::cos(s.flare_rad));
+                origin + d * (r + along * std::sin(flare_rad)) - Vec3::UnitY() * (along * std::cos(flare_rad));
         }
     }
-    auto topology = build_grid_topology(n, m, s.stride, true, grid, s.name);
+    auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
     g.body.character = character;
@@ -321,16 +311,10 @@ Result<void> validate(const ClothMaterial& m, std::string_view p) {
     return {};
 }
 
-Result<void> validate(const SkirtParams& s) {
-    return validate_tube("skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
-                         s.waist_height_fraction, "waist_height_fraction", s.waist_height_m, "waist_height_m",
+Result<void> validate(const TubeParams& s, std::string_view garment) {
+    return validate_tube(garment, s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
+                         s.ring_height_fraction, "ring_height_fraction", s.ring_height_m, "ring_height_m",
                          s.torso_radius_fraction, s.fitting_rows, s.material);
-}
-
-Result<void> validate(const DressParams& s) {
-    return validate_tube("dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
-                         s.shoulder_height_fraction, "shoulder_height_fraction", s.shoulder_height_m,
-                         "shoulder_height_m", s.torso_radius_fraction, s.fitting_rows, s.material);
 }
 
 Result<void> validate(const RectangleParams& r) {
@@ -460,22 +444,14 @@ std::vector<Entity> character_colliders(Registry& registry, Entity character) {
     return out;
 }
 
-Result<Entity> attach_skirt(Registry& registry, Entity character, const SkirtParams& s) {
-    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
-    return attach_tube(registry, character,
-                       TubeShape{"skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
-                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.waist_height_fraction,
-                                 s.waist_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
-                                 s.collision, s.color});
+Result<Entity> attach_skirt(Registry& registry, Entity character, const TubeParams& params) {
+    if (auto ok = validate(params, "skirt"); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character, "skirt", params);
 }
 
-Result<Entity> attach_dress(Registry& registry, Entity character, const DressParams& s) {
-    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
-    return attach_tube(registry, character,
-                       TubeShape{"dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
-                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.shoulder_height_fraction,
-                                 s.shoulder_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
-                                 s.collision, s.color});
+Result<Entity> attach_dress(Registry& registry, Entity character, const TubeParams& params) {
+    if (auto ok = validate(params, "dress"); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character, "dress", params);
 }
 
 Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity> colliders) {

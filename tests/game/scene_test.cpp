@@ -215,16 +215,16 @@ TEST(BuildWorld, BadScenesNameTheField) {
 
 TEST(ParticleLimit, OneLimitForScenesAndCppBuilders) {
     // A C++ builder refuses an absurd grid with the fields and the limit...
-    SkirtParams skirt;
+    TubeParams skirt = TubeParams::skirt();
     skirt.warp_lines = 1002;
     skirt.particles_per_line = 1000;
-    auto r = validate(skirt);
+    auto r = validate(skirt, "skirt");
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().message, "skirt.warp_lines x skirt.particles_per_line: must be at most 250000 particles, got 1002 x 1000 = 1002000");
-    DressParams dress;
+    TubeParams dress = TubeParams::dress();
     dress.warp_lines = 501;
     dress.particles_per_line = 500;
-    EXPECT_FALSE(validate(dress));
+    EXPECT_FALSE(validate(dress, "dress"));
     // ... and a scene asking for the most particles gets a garment within the same limit
     // (the grid's rounding may not pass it).
     SceneDescription scene = sample();
