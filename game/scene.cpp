@@ -17,6 +17,7 @@
 #include "engine/assets/character_import.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
+#include "game/scene_garment_parameters.hpp"
 #include "systems/cloth/garment_config.hpp"
 #include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
@@ -77,49 +78,6 @@ constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
 Quat euler_deg(const Vec3& deg) {
     return Quat(Eigen::AngleAxis<Real>(deg.y() * degrees, Vec3::UnitY()) * Eigen::AngleAxis<Real>(deg.x() * degrees, Vec3::UnitX()) *
                 Eigen::AngleAxis<Real>(deg.z() * degrees, Vec3::UnitZ()));
-}
-
-// A grid of about `particles` with the default grid's proportions; lines a multiple of the stride.
-void grid_for(int particles, int default_lines, int default_rows, int stride, int& lines, int& rows) {
-    const double aspect = double(default_rows) / double(default_lines);
-    const int s = std::max(1, stride);
-    lines = std::max(s * 2, static_cast<int>(std::lround(std::sqrt(particles / aspect) / s)) * s);
-    rows = std::max(2, static_cast<int>(std::lround(double(particles) / lines)));
-    rows = std::min(rows, max_garment_particles / lines);  // rounding must not pass the builders' limit
-}
-
-// Scene parameters onto the builder's parameters (`defaults`: the garment type's).
-void apply_parameters(TubeParams& p, const TubeParams& defaults, const GarmentDescription& g, std::string_view ring_fraction,
-                      std::string_view ring_height) {
-    std::optional<int> particles;
-    for (const GarmentParameter& q : g.parameters) {
-        const Real r = static_cast<Real>(q.value);
-        const int i = static_cast<int>(std::lround(q.value));
-        const std::string_view n = q.name;
-        if (n == "particles") particles = i;
-        else if (n == "warp_lines") p.warp_lines = i;
-        else if (n == "particles_per_line") p.particles_per_line = i;
-        else if (n == "weft_stride") p.weft_stride = i;
-        else if (n == "length_m") p.length_m = r;
-        else if (n == "flare_deg") p.flare_deg = r;
-        else if (n == "ease_m") p.ease_m = r;
-        else if (n == ring_fraction) p.ring_height_fraction = r;
-        else if (n == ring_height) p.ring_height_m = r;
-        else if (n == "torso_radius_fraction") p.torso_radius_fraction = r;
-        else if (n == "fitting_rows") p.fitting_rows = i;
-        else if (n == "mass_kg") p.material.mass_kg = r;
-        else if (n == "stretch_k_N_m") p.material.stretch_k_N_m = r;
-        else if (n == "shear_k_N_m") p.material.shear_k_N_m = r;
-        else if (n == "bend_k_N_m") p.material.bend_k_N_m = r;
-        else if (n == "drag_N_s_m") p.material.drag_N_s_m = r;
-        else if (n == "strain_limit") p.material.strain_limit = r;
-        else if (n == "strain_iterations") p.material.strain_iterations = i;
-        else if (n == "candidate_margin_m") p.material.candidate_margin_m = r;
-    }
-    if (particles) grid_for(*particles, defaults.warp_lines, defaults.particles_per_line, p.weft_stride, p.warp_lines, p.particles_per_line);
-    p.model = g.model;
-    p.collision = g.collision;
-    if (g.color) p.color = *g.color;
 }
 
 // Applies the scene's collider overrides for one character (after spawn, before dressing).
@@ -277,16 +235,10 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         const GarmentDescription& g = scene.garments[i];
         const std::string field = "garments[" + std::to_string(i) + "]";
         const Entity body = world.characters.at(static_cast<std::size_t>(g.character));
-        Result<Entity> garment = fail("");
-        if (g.type == GarmentType::skirt) {
-            TubeParams p = TubeParams::skirt();
-            apply_parameters(p, TubeParams::skirt(), g, "waist_height_fraction", "waist_height_m");
-            garment = attach_skirt(world.registry, body, p);
-        } else {
-            TubeParams p = TubeParams::dress();
-            apply_parameters(p, TubeParams::dress(), g, "shoulder_height_fraction", "shoulder_height_m");
-            garment = attach_dress(world.registry, body, p);
-        }
+        auto params = tube_params(g);
+        if (!params) return fail(located(g.where, field, params.error().message));
+        const Result<Entity> garment = g.type == GarmentType::skirt ? attach_skirt(world.registry, body, *params)
+                                                                    : attach_dress(world.registry, body, *params);
         if (!garment) return fail(located(g.where, field, garment.error().message));
         world.garments.push_back(*garment);
     }

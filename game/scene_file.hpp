@@ -63,8 +63,9 @@ enum class GarmentType : std::uint8_t { skirt, dress };
 [[nodiscard]] const char* cloth_model_name(ClothModel m) noexcept;
 [[nodiscard]] const char* collision_mode_name(CollisionMode m) noexcept;
 
-/// One numeric garment parameter set in a scene (the name is a field of TubeParams or
-/// its ClothMaterial; see garment_parameters()).
+/// One numeric garment parameter set in a scene: the name of a row of the garment
+/// parameter table (systems/cloth/garment_parameters.hpp) or "particles"
+/// (game/scene_garment_parameters.hpp).
 struct GarmentParameter {
     std::string name;
     double value = 0;
@@ -127,19 +128,6 @@ struct SceneDescription {
     CameraDescription camera;
     friend bool operator==(const SceneDescription&, const SceneDescription&) = default;
 };
-
-/// A numeric garment parameter a scene may set: its name, range and meaning.
-struct GarmentParameterSpec {
-    std::string_view name;               ///< A field of TubeParams / ClothMaterial, or "particles".
-    double min, max;                     ///< Range; max inclusive.
-    bool min_exclusive;                  ///< true: (min, max]; false: [min, max].
-    bool integer;
-    std::string_view doc;
-};
-
-/// The parameters a garment type accepts in a scene file (docs/scenes.md lists them).
-/// "particles" is a target count that chooses warp_lines and particles_per_line.
-[[nodiscard]] const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type);
 
 /// Upper bound on particles per garment accepted from a scene: the garment builders' own.
 inline constexpr int max_scene_particles = max_garment_particles;

@@ -14,7 +14,8 @@
 //     (weights of the nearest skin vertex when it has a SkinnedMesh, else its collider's
 //     bone), so the pins follow linear blend skinning like the body mesh;
 //   - otherwise bound rigidly to the nearest collider (analytic bodies).
-// Parameter errors name the field ("skirt.length_m: must be > 0").
+// Parameter errors name the field ("skirt.length_m: must be in (0, 10] m, got -1"); the
+// ranges are those of the garment parameter table (systems/cloth/garment_parameters.hpp).
 #pragma once
 
 #include <memory>

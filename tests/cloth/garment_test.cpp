@@ -71,10 +71,10 @@ TEST(Builders, ParameterErrorsNameTheField) {
     EXPECT_EQ(message(p).rfind("skirt.warp_lines: must be a multiple of skirt.weft_stride", 0), 0u) << message(p);
     p = {};
     p.material.mass_kg = std::numeric_limits<Real>::quiet_NaN();
-    EXPECT_EQ(message(p), "skirt.material.mass_kg: must be in (0, 100], got nan");
+    EXPECT_EQ(message(p), "skirt.material.mass_kg: must be in (0, 100] kg, got nan");
     p = {};
     p.material.stretch_k_N_m = Real(1e30);  // finite, but no float cloth survives it
-    EXPECT_EQ(message(p), "skirt.material.stretch_k_N_m: must be in (0, 1e7], got 1e+30");
+    EXPECT_EQ(message(p), "skirt.material.stretch_k_N_m: must be in (0, 1e7] N/m, got 1e+30");
     p = {};
     p.fitting_rows = 0;
     EXPECT_EQ(message(p).rfind("skirt.fitting_rows:", 0), 0u) << message(p);

@@ -12,6 +12,7 @@
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
 #include "game/scene.hpp"
+#include "game/scene_garment_parameters.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
@@ -293,17 +294,19 @@ TEST(BuildWorld, RandomGarmentParametersGiveAWorldOrOneError) {
         GarmentDescription& g = scene.garments[0];
         g.type = (i % 4 == 3) ? GarmentType::dress : GarmentType::skirt;
         g.model = (i % 2) ? ClothModel::classic : ClothModel::simplified;
-        for (const GarmentParameterSpec& spec : garment_parameters(g.type)) {
+        for (const ParameterSpec* spec : scene_garment_parameters()) {
             if (rng() % 3 != 0) continue;
-            if (spec.name == "particles" || spec.name == "warp_lines" || spec.name == "particles_per_line") {
-                if (spec.name == "particles") g.parameters.push_back({"particles", double(100 + rng() % 1500)});
+            if (spec->name == "particles" || spec->name == "warp_lines" || spec->name == "particles_per_line") {
+                if (spec->name == "particles") g.parameters.push_back({"particles", double(100 + rng() % 1500)});
                 continue;  // keep each case small
             }
-            std::uniform_real_distribution<double> u(spec.min, std::min(spec.max, spec.min + 10.0));
+            const ParameterRange& range = spec->range;
+            std::uniform_real_distribution<double> u(range.min, std::min(range.max, range.min + 10.0));
             double v = u(rng);
-            if (spec.integer) v = std::round(v);
-            if (spec.min_exclusive && v <= spec.min) v = spec.min + 0.01;
-            g.parameters.push_back({std::string(spec.name), v});
+            if (spec->kind == ParameterKind::integer) v = std::round(v);
+            if (range.min_open && v <= range.min) v = range.min + 0.01;
+            if (range.max_open && v >= range.max) v = range.max - 0.01;
+            g.parameters.push_back({std::string(spec->name), v});
         }
         auto world = build_world(scene, {});
         if (!world) {
