@@ -25,6 +25,9 @@ void add_make_avatar_command(CLI::App& app);
 /// `drape bench NAME`: benchmarks and reports (bench/).
 void add_bench_command(CLI::App& app);
 
+/// `drape scene-parameters`: the garment parameters of scene files, as docs/scenes.md lists them.
+void add_scene_parameters_command(CLI::App& app);
+
 /// Exit code of the subcommand that ran (set by its callback).
 int& command_exit_code();
 
