@@ -7,7 +7,7 @@
 //   for (int i = 0; i < 600; ++i) drape::step_world(*world, 1.0 / 60.0);
 //
 // Systems, in phase order (engine/core/scheduler.hpp): the character systems (animation,
-// skinning, colliders), then `teleport_guard`, then the cloth systems, then (when
+// skinning, colliders), then `teleport_guard` (systems/teleport_guard_system.hpp), then the cloth systems, then (when
 // rendering) the render system.
 //
 // Robustness (method-independent, docs/scenes.md "solver"):
@@ -30,6 +30,7 @@
 #include "engine/core/scheduler.hpp"
 #include "game/scene_file.hpp"
 #include "game/stats.hpp"
+#include "systems/teleport_guard_system.hpp"
 
 namespace drape {
 
@@ -41,12 +42,6 @@ struct WorldOptions {
     bool window = false;             ///< Render into an X11 window instead of off-screen.
     int width = 1280, height = 720;  ///< Frame size, px.
     bool profile = true;             ///< Time every system run (the frame budget table).
-};
-
-/// Counts of what the teleport guard did.
-struct TeleportLog {
-    std::uint64_t teleports = 0;     ///< Jumps detected.
-    std::uint64_t resets = 0;        ///< Garments reset because of them (or on request).
 };
 
 struct World {
