@@ -14,7 +14,7 @@
 #include "engine/assets/character_import.hpp"
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
 #include "systems/cloth_systems.hpp"

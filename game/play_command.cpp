@@ -25,7 +25,9 @@
 
 #include "game/commands.hpp"
 #include "game/output_files.hpp"
-#include "game/scene.hpp"
+#include "game/sample_scene.hpp"
+#include "game/scene_file.hpp"
+#include "game/world.hpp"
 #include "game/stats.hpp"
 #include "game/video.hpp"
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "game/scene_file.hpp"
+#include "game/scene_description.hpp"
 #include "systems/cloth/garment_builder.hpp"
 #include "systems/cloth/garment_parameters.hpp"
 

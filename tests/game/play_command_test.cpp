@@ -11,7 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
+#include "game/world.hpp"
 #include "game/video.hpp"
 #include "tests/character/test_character_file.hpp"
 

@@ -11,7 +11,10 @@
 #include "components/garment.hpp"
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
+#include "game/sample_scene.hpp"
+#include "game/scene_file.hpp"
+#include "game/world.hpp"
 #include "game/scene_garment_parameters.hpp"
 #include "systems/cloth/garment_builder.hpp"
 

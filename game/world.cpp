@@ -1,27 +1,23 @@
-#include "game/scene.hpp"
+// Worlds built from scene descriptions; see world.hpp.
+#include "game/world.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <map>
-#include <unistd.h>
 
 #include <tbb/global_control.h>
 
-#include "components/character.hpp"
-#include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
-#include "components/skeleton.hpp"
 #include "components/skinned_mesh.hpp"
-#include "components/transform.hpp"
 #include "engine/assets/character_import.hpp"
+#include "game/collider_overrides.hpp"
+#include "game/scene_file.hpp"
+#include "game/scene_garment_parameters.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
-#include "game/scene_garment_parameters.hpp"
+#include "systems/cloth/garment_builder.hpp"
 #include "systems/cloth/garment_config.hpp"
 #include "systems/cloth_systems.hpp"
 #include "systems/teleport_guard_system.hpp"
-#include "systems/cloth/garment_builder.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
 #include "engine/render/renderer.hpp"
@@ -32,6 +28,12 @@ namespace drape {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
+
+}  // namespace
+
 bool render_available() noexcept {
 #ifdef DRAPE_HAVE_RENDER
     return true;
@@ -39,92 +41,6 @@ bool render_available() noexcept {
     return false;
 #endif
 }
-
-fs::path asset_dir() {
-    std::error_code ec;
-    auto has_avatar = [&](const fs::path& dir) { return fs::is_regular_file(dir / "avatar.glb", ec); };
-    if (const char* env = std::getenv("DRAPE_ASSETS"); env != nullptr && *env != '\0') return fs::path(env);
-    if (has_avatar("assets")) return fs::absolute("assets", ec);
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec)
-        for (const fs::path& candidate : {exe.parent_path() / "../assets", exe.parent_path() / "../share/drape/assets"})
-            if (has_avatar(candidate)) return candidate.lexically_normal();
-#ifdef DRAPE_SOURCE_ASSETS
-    return fs::path(DRAPE_SOURCE_ASSETS);
-#else
-    return fs::absolute("assets", ec);
-#endif
-}
-
-fs::path default_avatar_path() { return asset_dir() / "avatar.glb"; }
-
-SceneDescription sample_scene() {
-    SceneDescription scene;
-    scene.description = "Drape's sample scene: the default avatar walking in place in a skirt";
-    CharacterDescription avatar;
-    avatar.file = default_avatar_path();
-    avatar.clip = "Walk";
-    scene.characters.push_back(avatar);
-    GarmentDescription skirt;
-    skirt.type = GarmentType::skirt;
-    skirt.color = Vec3(0.75f, 0.12f, 0.18f);
-    scene.garments.push_back(skirt);
-    return scene;
-}
-
-namespace {
-
-constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
-
-Quat euler_deg(const Vec3& deg) {
-    return Quat(Eigen::AngleAxis<Real>(deg.y() * degrees, Vec3::UnitY()) * Eigen::AngleAxis<Real>(deg.x() * degrees, Vec3::UnitX()) *
-                Eigen::AngleAxis<Real>(deg.z() * degrees, Vec3::UnitZ()));
-}
-
-// Applies the scene's collider overrides for one character (after spawn, before dressing).
-Result<void> apply_collider_overrides(World& world, const SceneDescription& scene, std::size_t index, const CharacterAsset& asset) {
-    Registry& registry = world.registry;
-    const Entity character = world.characters[index];
-    for (std::size_t k = 0; k < scene.colliders.size(); ++k) {
-        const ColliderOverride& o = scene.colliders[k];
-        if (o.character != static_cast<int>(index)) continue;
-        const std::string field = "colliders[" + std::to_string(k) + "].bone";
-        const int bone = asset.skeleton ? asset.skeleton->find(o.bone) : -1;
-        if (bone < 0) {
-            std::string bones;
-            if (asset.skeleton)
-                for (std::size_t b = 0; b < asset.skeleton->bone_names.size() && b < 12; ++b)
-                    bones += (b ? ", " : "") + asset.skeleton->bone_names[b];
-            return fail(located(o.where, field, "no bone \"" + o.bone + "\" in " + asset.source.string() + " (bones: " + bones +
-                                                    (asset.skeleton && asset.skeleton->size() > 12 ? ", ..." : "") + ")"));
-        }
-        std::vector<Entity> on_bone;
-        for (Entity e : colliders_of(registry, character))
-            if (const auto* c = registry.try_get<EllipsoidCollider>(e); c && c->bone == bone) on_bone.push_back(e);
-        if (o.remove) {
-            if (on_bone.empty()) return fail(located(o.where, field, "bone \"" + o.bone + "\" has no fitted ellipsoid to remove"));
-            for (Entity e : on_bone) registry.destroy(e);
-            continue;
-        }
-        if (on_bone.empty()) {  // a new ellipsoid on this bone
-            const Entity e = registry.create();
-            EllipsoidCollider& c = registry.emplace<EllipsoidCollider>(e);
-            c.character = character;
-            c.bone = bone;
-            on_bone.push_back(e);
-        }
-        for (Entity e : on_bone) {
-            EllipsoidCollider& c = registry.get<EllipsoidCollider>(e);
-            if (o.center_m) c.center = *o.center_m;
-            if (o.radii_m) c.radii_m = *o.radii_m;
-            if (o.rotation_deg) c.rotation = euler_deg(*o.rotation_deg);
-            c.initialised = false;
-        }
-    }
-    return {};
-}
-
-}  // namespace
 
 Result<World> build_world(const SceneDescription& scene, const WorldOptions& options) {
     if (auto ok = validate(scene); !ok) return std::unexpected(ok.error());
@@ -169,7 +85,8 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         auto entity = spawn_character(world.registry, asset, spawn);
         if (!entity) return fail(located(c.where, "characters[" + std::to_string(i) + "]", entity.error().message));
         world.characters.push_back(*entity);
-        if (auto ok = apply_collider_overrides(world, scene, i, *asset); !ok) return std::unexpected(ok.error());
+        if (auto ok = apply_collider_overrides(world.registry, *entity, i, scene.colliders, *asset); !ok)
+            return std::unexpected(ok.error());
     }
 
     // Systems: characters, teleport guard, cloth (+ fixed substeps), render.
