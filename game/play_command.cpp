@@ -2,11 +2,6 @@
 // frames, writes what was asked (PNG frames, a video, a trace, stats) and prints the frame
 // budget. Usage and options: README.md "Playing scenes" and `drape play --help`.
 
-// GCC 12 with the sanitizers warns inside libstdc++'s <regex> (the std::function in its
-// automaton's states: -Wmaybe-uninitialized, a false positive); the standard headers are
-// read with that warning off.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -14,12 +9,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
-#include <regex>
 #include <string>
 #include <thread>
 #include <tuple>
 #include <vector>
-#pragma GCC diagnostic pop
 
 #include <unistd.h>
 
@@ -36,11 +29,6 @@
 #endif
 
 namespace drape {
-
-int& command_exit_code() {
-    static int code = 0;
-    return code;
-}
 
 namespace {
 
@@ -60,60 +48,7 @@ volatile std::sig_atomic_t g_interrupted = 0;
 void on_interrupt(int) { g_interrupted = 1; }
 
 // Errors of this command: "drape play: --size: must be WxH ..." on stderr, exit code 1.
-int report(const std::string& message) {
-    std::fprintf(stderr, "drape play: %s\n", message.c_str());
-    command_exit_code() = exit_bad_input;
-    return exit_bad_input;
-}
-
-// The frames `--out DIR` writes: frame_00000.png, frame_00001.png, ...
-bool is_frame_file(const fs::path& file) {
-    static const std::regex name(R"(frame_\d{5}\.png)");
-    return std::regex_match(file.filename().string(), name);
-}
-
-std::vector<fs::path> frame_files(const fs::path& folder) {
-    std::vector<fs::path> out;
-    std::error_code ec;
-    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
-        if (is_frame_file(it->path())) out.push_back(it->path());
-    return out;
-}
-
-// Everything this run creates (folders, frames), removed again unless the run completes:
-// a run that fails leaves nothing behind and never removes what existed before it.
-class CreatedOutputs {
-public:
-    CreatedOutputs() = default;
-    CreatedOutputs(const CreatedOutputs&) = delete;
-    CreatedOutputs& operator=(const CreatedOutputs&) = delete;
-    ~CreatedOutputs() {
-        if (m_kept) return;
-        std::error_code ec;
-        for (const fs::path& f : m_files) fs::remove(f, ec);
-        for (auto it = m_folders.rbegin(); it != m_folders.rend(); ++it) fs::remove(*it, ec);  // only when empty
-    }
-    // Creates `folder` and its missing parents, remembering each one it made.
-    Result<void> create_folder(const fs::path& folder) {
-        std::vector<fs::path> missing;
-        std::error_code ec;
-        for (fs::path p = folder; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-            missing.push_back(p);
-            if (p == p.parent_path()) break;
-        }
-        for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-            if (!fs::create_directory(*it, ec) && ec) return fail(it->string() + ": cannot create the folder: " + ec.message());
-            m_folders.push_back(*it);
-        }
-        return {};
-    }
-    void add_file(const fs::path& file) { m_files.push_back(file); }
-    void keep() { m_kept = true; }
-
-private:
-    std::vector<fs::path> m_files, m_folders;
-    bool m_kept = false;
-};
+int report(const std::string& message) { return command_error("play", message); }
 
 Result<std::pair<int, int>> parse_size(const std::string& text) {
     int w = 0, h = 0;
@@ -124,16 +59,6 @@ Result<std::pair<int, int>> parse_size(const std::string& text) {
     if (w < 16 || h < 16 || w > 8192 || h > 8192)
         return fail("--size: each side must be in [16, 8192] pixels, got " + text);
     return std::pair{w, h};
-}
-
-// A path under `folder` named stem + n + extension that does not exist yet: default
-// outputs never overwrite anything.
-fs::path fresh_path(const fs::path& folder, const std::string& stem, const std::string& extension) {
-    std::error_code ec;
-    for (int n = 1;; ++n) {
-        fs::path p = folder / (n == 1 ? stem + extension : stem + "-" + std::to_string(n) + extension);
-        if (!fs::exists(p, ec)) return p;
-    }
 }
 
 // Applies the command-line overrides to a scene.
@@ -348,10 +273,9 @@ int play(const PlayOptions& o) {
                 if (video)
                     if (auto ok = video->write(image); !ok) return video_error(ok.error().message);
                 if (!frame_folder.empty()) {
-                    char name[32];
-                    std::snprintf(name, sizeof name, "frame_%05d.png", played - 1);
-                    created.add_file(frame_folder / name);
-                    if (auto ok = write_png(image, frame_folder / name); !ok) return report(ok.error().message);
+                    const fs::path file = frame_folder / frame_file_name(played - 1);
+                    created.add_file(file);
+                    if (auto ok = write_png(image, file); !ok) return report(ok.error().message);
                 }
             }
         }
@@ -363,12 +287,7 @@ int play(const PlayOptions& o) {
         if (auto ok = commit_partial(video->file(), video_file); !ok) return report(ok.error().message);
     }
     // The folder now holds this run's frames only (older frames past the last one go).
-    if (!frame_folder.empty())
-        for (const fs::path& f : frame_files(frame_folder))
-            if (std::stoi(f.filename().string().substr(6, 5)) >= played) {
-                std::error_code ec;
-                fs::remove(f, ec);
-            }
+    if (!frame_folder.empty()) remove_frames_from(frame_folder, played);
     created.keep();
     if (g_interrupted) std::printf("drape play: interrupted after %d frames\n", played);
 
