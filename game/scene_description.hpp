@@ -49,7 +49,9 @@ struct CharacterDescription {
     friend bool operator==(const CharacterDescription&, const CharacterDescription&) = default;
 };
 
+/// Which builder dresses the character (attach_skirt or attach_dress).
 enum class GarmentType : std::uint8_t { skirt, dress };
+/// Names as scene files write them: "skirt", "simplified", "lists", ...
 [[nodiscard]] const char* garment_type_name(GarmentType t) noexcept;
 [[nodiscard]] const char* cloth_model_name(ClothModel m) noexcept;
 [[nodiscard]] const char* collision_mode_name(CollisionMode m) noexcept;
@@ -110,6 +112,7 @@ struct CameraDescription {
     friend bool operator==(const CameraDescription&, const CameraDescription&) = default;
 };
 
+/// Everything a world holds (docs/scenes.md).
 struct SceneDescription {
     std::string description;             ///< Free text (JSON has no comments).
     std::vector<CharacterDescription> characters;

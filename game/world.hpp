@@ -44,6 +44,8 @@ struct WorldOptions {
     bool profile = true;             ///< Time every system run (the frame budget table).
 };
 
+/// A running scene: its description, registry, scheduler with the systems, its entities,
+/// and the renderer when it renders.
 struct World {
     SceneDescription scene;
     Registry registry;
