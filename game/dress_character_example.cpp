@@ -14,7 +14,7 @@
 #include "engine/assets/character_import.hpp"
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
 #include "systems/cloth_systems.hpp"
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     // 4. The skirt: a cone hung from the fitted hip ellipsoids, top row pinned to the skin.
     //    The builder fits around placed colliders: one skinning pass places them.
     scheduler.run_phase(registry, drape::Phase::skinning, drape::FrameContext{.fixed_dt_s = 1.0 / 60.0});
-    drape::SkirtParams skirt;  // 27 x 31 = 837 particles, the paper's skirt
+    const drape::TubeParams skirt = drape::TubeParams::skirt();  // 27 x 31 = 837 particles, the paper's skirt
     auto garment = drape::attach_skirt(registry, *character, skirt);
     if (!garment) return fail_with(garment.error().message);
 

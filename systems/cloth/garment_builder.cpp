@@ -14,6 +14,7 @@
 #include "components/transform.hpp"
 #include "systems/cloth/body.hpp"
 #include "systems/cloth/collision.hpp"
+#include "systems/cloth/garment_parameters.hpp"
 #include "systems/cloth/garment_step.hpp"
 #include "systems/cloth/pins.hpp"
 
@@ -30,9 +31,9 @@ std::string number(Real v) {
     s << v;
     return s.str();
 }
-// In (0, hi] (or [0, hi] when zero is allowed), finite. The upper bounds are those of the
-// scene files' garment parameters (game/scene_file.cpp): beyond them float arithmetic, not
-// the cloth, decides what happens.
+// In (0, hi] (or [0, hi] when zero is allowed), finite: a rectangle's sizes. (The skirt's
+// and the dress's ranges are in the garment parameter table.) Beyond them float arithmetic,
+// not the cloth, decides what happens.
 bool in_range(Real v, Real hi, bool zero_allowed = false) {
     return std::isfinite(v) && (zero_allowed ? v >= 0 : v > 0) && v <= hi;
 }
@@ -57,25 +58,14 @@ Result<void> validate_grid(std::string_view p, int lines, int per_line, int stri
     return {};
 }
 
-Result<void> validate_tube(std::string_view p, int lines, int per_line, int stride, Real length, Real flare_deg,
-                           Real ease, Real height_fraction, std::string_view height_fraction_name, Real height_m,
-                           std::string_view height_m_name, Real torso_fraction, int fitting_rows,
-                           const ClothMaterial& material) {
-    if (auto ok = validate_grid(p, lines, per_line, stride, true); !ok) return ok;
-    if (!in_range(length, 10)) return fail(field(p, "length_m") + ": must be in (0, 10] m, got " + number(length));
-    if (!std::isfinite(flare_deg) || flare_deg < 0 || flare_deg > 80)
-        return fail(field(p, "flare_deg") + ": must be in [0, 80], got " + number(flare_deg));
-    if (!std::isfinite(ease) || ease < 0 || ease > 1)
-        return fail(field(p, "ease_m") + ": must be in [0, 1], got " + number(ease));
-    if (!std::isfinite(height_fraction) || height_fraction <= 0 || height_fraction >= 1)
-        return fail(field(p, height_fraction_name) + ": must be in (0, 1), got " + number(height_fraction));
-    if (!in_range(height_m, 10, true))
-        return fail(field(p, height_m_name) + ": must be in [0, 10] m (0 = from the fraction), got " + number(height_m));
-    if (!in_range(torso_fraction, 1))
-        return fail(field(p, "torso_radius_fraction") + ": must be in (0, 1], got " + number(torso_fraction));
-    if (fitting_rows < 1 || fitting_rows >= per_line)
-        return fail(field(p, "fitting_rows") + ": must be in [1, particles_per_line), got " + std::to_string(fitting_rows));
-    return validate(material, field(p, "material"));
+// One row of the parameter table against its value: "skirt.length_m: must be in (0, 10] m, got -1".
+Result<void> check(const GarmentParameterSpec& spec, double value, std::string_view p, std::string_view field_name) {
+    if (spec.range.contains(value)) return {};
+    std::string message = field(p, field_name) + ": must be in " + spec.range.text();
+    if (!spec.unit.empty()) message += " " + std::string(spec.unit);
+    message += ", got ";
+    message += spec.kind == ParameterKind::integer ? std::to_string(static_cast<long long>(value)) : number(static_cast<Real>(value));
+    return fail(message);
 }
 
 // Particle-order positions from grid-order positions.
@@ -112,17 +102,6 @@ Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     if (disc < 0 || a <= 0) return -1;
     return (-b + std::sqrt(disc)) / (2 * a);
 }
-
-struct TubeShape {
-    std::string_view name;
-    int lines, per_line, stride;
-    Real length_m, flare_rad, ease_m, height_fraction, height_m, torso_fraction;
-    int fitting_rows;
-    ClothMaterial material;
-    ClothModel model;
-    CollisionMode collision;
-    Vec3 color;
-};
 
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
@@ -226,8 +205,8 @@ Result<Entity> finish(Registry& registry, Garment g, int rows) {
     return e;
 }
 
-Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape& s) {
-    const std::string p(s.name);
+Result<Entity> attach_tube(Registry& registry, Entity character, std::string_view name, const TubeParams& s) {
+    const std::string p(name);
     if (!registry.valid(character)) return fail(p + ": the character entity is not alive");
     const std::vector<Entity> colliders = character_colliders(registry, character);
     if (colliders.empty()) return fail(p + ": the character has no ellipsoid colliders");
@@ -256,7 +235,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
     if (active == 0) return fail(p + ": the character's colliders are degenerate (zero radii)");
     axis /= Real(active);
     const Real height = top - bottom;
-    const Real ring_y = bottom + (s.height_m > 0 ? s.height_m : s.height_fraction * height);
+    const Real ring_y = bottom + (s.ring_height_m > 0 ? s.ring_height_m : s.ring_height_fraction * height);
     const Vec3 origin(axis.x(), ring_y, axis.z());
 
     // Outline colliders: cross the ring height, near the axis.
@@ -265,13 +244,14 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
         const EllipsoidFrame& f = frames[e];
         if (!f.active || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
         const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
-        if (off.norm() > s.torso_fraction * height) continue;
+        if (off.norm() > s.torso_radius_fraction * height) continue;
         outline.push_back(e);
     }
     if (outline.empty())
         return fail(p + ": no collider crosses the ring height " + number(ring_y) + " m near the body axis");
 
-    const int n = s.lines, m = s.per_line;
+    const int n = s.warp_lines, m = s.particles_per_line;
+    const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;
     const Real step = s.length_m / Real(m - 1);
     Matrix3X grid(3, n * m);
     for (int line = 0; line < n; ++line) {
@@ -284,10 +264,10 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
         for (int row = 0; row < m; ++row) {
             const Real along = step * Real(row);
             grid.col(line * m + row) =
-                origin + d * (r + along * std::sin(s.flare_rad)) - Vec3::UnitY() * (along * std::cos(s.flare_rad));
+                origin + d * (r + along * std::sin(flare_rad)) - Vec3::UnitY() * (along * std::cos(flare_rad));
         }
     }
-    auto topology = build_grid_topology(n, m, s.stride, true, grid, s.name);
+    auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
     g.body.character = character;
@@ -303,34 +283,20 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
 }  // namespace
 
 Result<void> validate(const ClothMaterial& m, std::string_view p) {
-    if (!in_range(m.mass_kg, 100)) return fail(field(p, "mass_kg") + ": must be in (0, 100], got " + number(m.mass_kg));
-    if (!in_range(m.stretch_k_N_m, 1e7))
-        return fail(field(p, "stretch_k_N_m") + ": must be in (0, 1e7], got " + number(m.stretch_k_N_m));
-    if (!in_range(m.shear_k_N_m, 1e7, true))
-        return fail(field(p, "shear_k_N_m") + ": must be in [0, 1e7], got " + number(m.shear_k_N_m));
-    if (!in_range(m.bend_k_N_m, 1e7, true))
-        return fail(field(p, "bend_k_N_m") + ": must be in [0, 1e7], got " + number(m.bend_k_N_m));
-    if (!in_range(m.drag_N_s_m, 100, true))
-        return fail(field(p, "drag_N_s_m") + ": must be in [0, 100], got " + number(m.drag_N_s_m));
-    if (!std::isfinite(m.strain_limit) || m.strain_limit <= 0 || m.strain_limit > 10)
-        return fail(field(p, "strain_limit") + ": must be in (0, 10], got " + number(m.strain_limit));
-    if (m.strain_iterations < 0 || m.strain_iterations > 100)
-        return fail(field(p, "strain_iterations") + ": must be in [0, 100], got " + std::to_string(m.strain_iterations));
-    if (!in_range(m.candidate_margin_m, 1))
-        return fail(field(p, "candidate_margin_m") + ": must be in (0, 1] m, got " + number(m.candidate_margin_m));
+    for (const GarmentParameterSpec& spec : garment_parameters())
+        if (spec.in_material())
+            if (auto ok = check(spec, spec.get(m), p, spec.name); !ok) return ok;
     return {};
 }
 
-Result<void> validate(const SkirtParams& s) {
-    return validate_tube("skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
-                         s.waist_height_fraction, "waist_height_fraction", s.waist_height_m, "waist_height_m",
-                         s.torso_radius_fraction, s.fitting_rows, s.material);
-}
-
-Result<void> validate(const DressParams& s) {
-    return validate_tube("dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
-                         s.shoulder_height_fraction, "shoulder_height_fraction", s.shoulder_height_m,
-                         "shoulder_height_m", s.torso_radius_fraction, s.fitting_rows, s.material);
+Result<void> validate(const TubeParams& s, std::string_view garment) {
+    for (const GarmentParameterSpec& spec : garment_parameters())
+        if (auto ok = check(spec, spec.get(s), garment, spec.field()); !ok) return ok;
+    // What one row cannot say: the grid as a whole, and the pins within it.
+    if (auto ok = validate_grid(garment, s.warp_lines, s.particles_per_line, s.weft_stride, true); !ok) return ok;
+    if (s.fitting_rows >= s.particles_per_line)
+        return fail(field(garment, "fitting_rows") + ": must be in [1, particles_per_line), got " + std::to_string(s.fitting_rows));
+    return {};
 }
 
 Result<void> validate(const RectangleParams& r) {
@@ -460,22 +426,14 @@ std::vector<Entity> character_colliders(Registry& registry, Entity character) {
     return out;
 }
 
-Result<Entity> attach_skirt(Registry& registry, Entity character, const SkirtParams& s) {
-    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
-    return attach_tube(registry, character,
-                       TubeShape{"skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
-                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.waist_height_fraction,
-                                 s.waist_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
-                                 s.collision, s.color});
+Result<Entity> attach_skirt(Registry& registry, Entity character, const TubeParams& params) {
+    if (auto ok = validate(params, "skirt"); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character, "skirt", params);
 }
 
-Result<Entity> attach_dress(Registry& registry, Entity character, const DressParams& s) {
-    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
-    return attach_tube(registry, character,
-                       TubeShape{"dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
-                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.shoulder_height_fraction,
-                                 s.shoulder_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
-                                 s.collision, s.color});
+Result<Entity> attach_dress(Registry& registry, Entity character, const TubeParams& params) {
+    if (auto ok = validate(params, "dress"); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character, "dress", params);
 }
 
 Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity> colliders) {

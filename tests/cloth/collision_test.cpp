@@ -79,7 +79,7 @@ TEST(Collision, OverlappingEllipsoidsLeaveNoParticleInside) {
 using Dress = std::function<Entity(Registry&, Entity character, ClothModel, CollisionMode)>;
 
 Entity default_skirt(Registry& registry, Entity character, ClothModel model, CollisionMode mode) {
-    SkirtParams params;
+    TubeParams params = TubeParams::skirt();
     params.model = model;
     params.collision = mode;
     return *attach_skirt(registry, character, params);
@@ -87,7 +87,7 @@ Entity default_skirt(Registry& registry, Entity character, ClothModel model, Col
 
 // A 2,520-particle dress (the default's layout at half the resolution: the test stays quick).
 Entity small_dress(Registry& registry, Entity character, ClothModel model, CollisionMode mode) {
-    DressParams params;
+    TubeParams params = TubeParams::dress();
     params.warp_lines = 60;
     params.particles_per_line = 42;
     params.model = model;
@@ -397,7 +397,7 @@ TEST(Collision, BruteForceAndListsGiveTheSameGarmentOnAStaticBody) {
         test::WalkSettings still;
         still.hip_swing_rad = still.knee_bend_rad = still.forward_speed_m_s = still.yaw_rad = 0;
         test::AnalyticBody body(registry, still);
-        SkirtParams params;
+        TubeParams params = TubeParams::skirt();
         params.collision = mode;
         const Entity e = *attach_skirt(registry, body.character, params);
         Scheduler scheduler;

@@ -40,7 +40,7 @@ class ConstraintOnWalkingSkirt : public ::testing::TestWithParam<ClothModel> {};
 TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringLongerThanTenPercentAfterTheConstraintSystem) {
     Registry registry;
     test::AnalyticBody body(registry);
-    SkirtParams params;
+    TubeParams params = TubeParams::skirt();
     params.model = GetParam();
     const Entity e = *attach_skirt(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
@@ -61,7 +61,7 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringLongerThanTenPercentAfterTheConstra
 TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringOfAWalkingDressLongerThanTenPercentAfterTheConstraintSystem) {
     Registry registry;
     test::AnalyticBody body(registry);
-    DressParams params;
+    TubeParams params = TubeParams::dress();
     params.model = GetParam();
     const Entity e = *attach_dress(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
@@ -94,7 +94,7 @@ TEST_P(ConstraintOnWalkingSkirt, NoWarpSpringOfAWalkingDressLongerThanTenPercent
 TEST_P(ConstraintOnWalkingSkirt, PinnedParticlesAreNeverMovedByTheConstraints) {
     Registry registry;
     test::AnalyticBody body(registry);
-    SkirtParams params;
+    TubeParams params = TubeParams::skirt();
     params.model = GetParam();
     const Entity e = *attach_skirt(registry, body.character, params);
     Garment& g = registry.get<Garment>(e);
@@ -113,7 +113,7 @@ INSTANTIATE_TEST_SUITE_P(Models, ConstraintOnWalkingSkirt,
 TEST(Weft, LayerTwoParticlesLieOnTheirPlanesAfterTheConstraintSystem) {
     Registry registry;
     test::AnalyticBody body(registry);
-    const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
+    const Entity e = *attach_skirt(registry, body.character, TubeParams::skirt());
     Garment& g = registry.get<Garment>(e);
     GarmentSolver& solver = registry.get<GarmentSolver>(e);
     const Fabric& t = *g.fabric;

@@ -64,7 +64,7 @@ TEST(StrainCollision, ParticlesInOverlappingLimbsLeaveThroughTheSideNotTheFarEnd
 TEST(StrainCollision, WalkingSkirtPushOutsStayShorterThanTheLargestRadius) {
     Registry registry;
     test::AnalyticBody body(registry);
-    const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
+    const Entity e = *attach_skirt(registry, body.character, TubeParams::skirt());
     Garment& g = registry.get<Garment>(e);
     GarmentSolver& solver = registry.get<GarmentSolver>(e);
     const Fabric& t = *g.fabric;

@@ -63,7 +63,7 @@ void expect_layer2_bounds(const Garment& g, Real limit, Checked& checked, bool b
 TEST(StrainLayer2, WalkingSkirtHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem) {
     Registry registry;
     test::AnalyticBody body(registry);
-    const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
+    const Entity e = *attach_skirt(registry, body.character, TubeParams::skirt());
     Garment& g = registry.get<Garment>(e);
     GarmentSolver& solver = registry.get<GarmentSolver>(e);
     Checked checked;
@@ -77,7 +77,7 @@ TEST(StrainLayer2, WalkingSkirtHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem
 TEST(StrainLayer2, WalkingDressHoldsTheWarpAndWeftBoundsAfterTheConstraintSystem) {
     Registry registry;
     test::AnalyticBody body(registry);
-    const Entity e = *attach_dress(registry, body.character, DressParams{});
+    const Entity e = *attach_dress(registry, body.character, TubeParams::dress());
     Garment& g = registry.get<Garment>(e);
     GarmentSolver& solver = registry.get<GarmentSolver>(e);
     Checked checked;

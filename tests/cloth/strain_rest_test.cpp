@@ -12,7 +12,7 @@ namespace {
 TEST(StrainRest, SkirtOnAStillBodyComesToRest) {
     Registry registry;
     test::AnalyticBody body(registry);
-    const Entity e = *attach_skirt(registry, body.character, SkirtParams{});
+    const Entity e = *attach_skirt(registry, body.character, TubeParams::skirt());
     Garment& g = registry.get<Garment>(e);
     GarmentSolver& solver = registry.get<GarmentSolver>(e);
     double mean_speed = 0;

@@ -17,7 +17,8 @@
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
 #include "components/transform.hpp"
-#include "game/scene.hpp"
+#include "game/sample_scene.hpp"
+#include "game/world.hpp"
 
 namespace drape {
 namespace {

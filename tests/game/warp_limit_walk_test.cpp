@@ -8,7 +8,9 @@
 
 #include <filesystem>
 
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
+#include "game/sample_scene.hpp"
+#include "game/world.hpp"
 #include "systems/cloth/garment_step.hpp"
 #include "systems/cloth/weft.hpp"
 
