@@ -6,6 +6,8 @@
 
 #include <tbb/global_control.h>
 
+#include "components/animation_player.hpp"
+#include "components/character.hpp"
 #include "components/garment.hpp"
 #include "components/skinned_mesh.hpp"
 #include "engine/assets/character_import.hpp"
@@ -176,7 +178,16 @@ Result<void> set_time_scale(World& world, double scale) {
 }
 
 RunStats run_stats(const World& world) {
-    return make_run_stats(world.scheduler.profiler(), world.scheduler.settings().fixed_dt_s, world.watch, world.registry);
+    RunStats stats = make_run_stats(world.scheduler.profiler(), world.scheduler.settings().fixed_dt_s, world.watch, world.registry);
+    for (std::size_t i = 0; i < world.characters.size(); ++i) {
+        CharacterStats c;
+        if (i < world.scene.characters.size()) c.file = world.scene.characters[i].file.string();
+        if (const auto* character = world.registry.try_get<Character>(world.characters[i])) c.height_m = character->height_m;
+        if (const auto* player = world.registry.try_get<AnimationPlayer>(world.characters[i]); player && player->clip)
+            c.clip = player->clip->name;
+        stats.characters.push_back(std::move(c));
+    }
+    return stats;
 }
 
 bool has_nonfinite(const World& world) {
