@@ -82,7 +82,7 @@ Garment make_instance(std::shared_ptr<const Fabric> fabric, Matrix3X x, const Cl
     g.fabric = std::move(fabric);
     g.state.x = std::move(x);
     g.state.v = Matrix3X::Zero(3, n);
-    g.state.inv_mass = VectorX::Constant(n, Real(n) / material.mass_kg);
+    g.state.inv_mass = (material.areal_density_kg_m2 * g.fabric->area_m2).cwiseInverse();
     g.config.material = material;
     g.config.model = model;
     g.config.collision = collision;
@@ -214,10 +214,13 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
                                            " colliders; a garment handles at most 64");
     std::vector<EllipsoidFrame> frames;
     bool placed = false;
+    std::vector<std::uint8_t> limb;  // arms, hands, head: never part of the body's outline
     for (Entity e : colliders) {
         const auto& c = registry.get<EllipsoidCollider>(e);
         placed = placed || c.initialised;
         frames.push_back(make_ellipsoid_frame(c.world));
+        const BodyRegion r = c.region;
+        limb.push_back(r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::head);
     }
     if (!placed) return fail(p + ": the character's colliders have not been placed yet (run the collider system once)");
 
@@ -242,7 +245,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     std::vector<std::size_t> outline;
     for (std::size_t e = 0; e < frames.size(); ++e) {
         const EllipsoidFrame& f = frames[e];
-        if (!f.active || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
+        if (!f.active || limb[e] || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
         const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
         if (off.norm() > s.torso_radius_fraction * height) continue;
         outline.push_back(e);
@@ -261,10 +264,23 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
         for (std::size_t e : outline) r = std::max(r, ray_exit(frames[e], origin, d));
         if (r <= 0) return fail(p + ": the body outline at the ring height does not surround the axis");
         r += s.ease_m;
+        // Down the cone, but never closer to the axis than the body below the ring (hips,
+        // thighs, bust) plus the ease: the rest shape must fit over the body, or the cloth
+        // would hang stretched over it. Once widened, the line keeps its width below.
+        Real widest = r;
         for (int row = 0; row < m; ++row) {
             const Real along = step * Real(row);
-            grid.col(line * m + row) =
-                origin + d * (r + along * std::sin(flare_rad)) - Vec3::UnitY() * (along * std::cos(flare_rad));
+            const Vec3 centre = origin - Vec3::UnitY() * (along * std::cos(flare_rad));
+            Real need = 0;
+            for (std::size_t e = 0; e < frames.size(); ++e) {
+                const EllipsoidFrame& f = frames[e];
+                if (!f.active || limb[e] || std::abs(f.center.y() - centre.y()) >= half_height(f)) continue;
+                const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
+                if (off.norm() > s.torso_radius_fraction * height) continue;  // arms, hands
+                need = std::max(need, ray_exit(f, centre, d) + s.ease_m);
+            }
+            widest = std::max({widest, r + along * std::sin(flare_rad), need});
+            grid.col(line * m + row) = centre + d * widest;
         }
     }
     auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
@@ -328,19 +344,22 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
     const auto is_layer1 = [&](std::uint32_t line) { return line % stride == 0; };
     const auto gi = [&](std::uint32_t line, std::uint32_t row) { return line * m + row; };
 
-    // Particle order: layer-1 lines first (one contiguous block to integrate), then layer 2.
+    // Particle order: layer 1 first (one contiguous block to integrate), then layer 2 by the
+    // lines' place between their layer-1 neighbours (line % stride); within each block row
+    // by row, the block's lines side by side. A row of warp springs of one block, or of weft
+    // springs between two blocks, then joins consecutive particles to consecutive particles:
+    // the solver takes each such row as one strip of independent springs, rows from the
+    // fitting zone down (constraints.hpp).
     t->grid.assign(n * m, 0);
     t->layer.assign(n * m, 0);
     std::uint32_t next = 0;
-    for (int pass = 1; pass <= 2; ++pass)
-        for (std::uint32_t line = 0; line < n; ++line)
-            if (is_layer1(line) == (pass == 1))
-                for (std::uint32_t row = 0; row < m; ++row) {
-                    t->grid[gi(line, row)] = next;
-                    t->layer[next++] = static_cast<std::uint8_t>(pass);
-                }
+    for (std::uint32_t offset = 0; offset < stride; ++offset)
+        for (std::uint32_t row = 0; row < m; ++row)
+            for (std::uint32_t line = offset; line < n; line += stride) {
+                t->grid[gi(line, row)] = next;
+                t->layer[next++] = static_cast<std::uint8_t>(offset == 0 ? 1 : 2);
+            }
     t->layer1_count = static_cast<std::uint32_t>(std::count(t->layer.begin(), t->layer.end(), 1));
-    t->layer1_mass_scale = Real(n * m) / Real(t->layer1_count);
 
     const auto at = [&](std::uint32_t line, std::uint32_t row) { return t->grid[gi(line, row)]; };
     const auto rest = [&](std::uint32_t a_line, std::uint32_t a_row, std::uint32_t b_line, std::uint32_t b_row) {
@@ -353,26 +372,51 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
         if (!(r > Real(1e-6))) degenerate = "two neighbouring particles coincide at rest";
         phase.add(at(al, ar), at(bl, br), r);
     };
-    // Warp springs line by line from the fitting zone (row 0) outward.
+    // Every phase line by line, rows from the fitting zone (row 0) outward: a line's springs
+    // are then runs of consecutive particles, which the solver takes a strip at a time
+    // (constraints.hpp).
     for (std::uint32_t line = 0; line < n; ++line)
         for (std::uint32_t row = 0; row + 1 < m; ++row) add(is_layer1(line) ? t->warp1 : t->warp2, line, row, line, row + 1);
-    for (std::uint32_t row = 0; row < m; ++row)
-        for (std::uint32_t line = 0; line < weft_lines; ++line) add(t->weft, line, row, (line + 1) % n, row);
-    for (std::uint32_t row = 0; row < m; ++row)
-        for (std::uint32_t line = 0; line < n; line += stride)
-            if (closed || line + stride < n) add(t->weft1, line, row, (line + stride) % n, row);
     for (std::uint32_t line = 0; line < weft_lines; ++line)
-        for (std::uint32_t row = 0; row + 1 < m; ++row) {
-            add(t->shear, line, row, (line + 1) % n, row + 1);
-            add(t->shear, (line + 1) % n, row, line, row + 1);
-        }
+        for (std::uint32_t row = 0; row < m; ++row) add(t->weft, line, row, (line + 1) % n, row);
+    for (std::uint32_t line = 0; line < n; line += stride)
+        if (closed || line + stride < n)
+            for (std::uint32_t row = 0; row < m; ++row) add(t->weft1, line, row, (line + stride) % n, row);
+    for (std::uint32_t line = 0; line < weft_lines; ++line) {
+        for (std::uint32_t row = 0; row + 1 < m; ++row) add(t->shear, line, row, (line + 1) % n, row + 1);
+        for (std::uint32_t row = 0; row + 1 < m; ++row) add(t->shear, (line + 1) % n, row, line, row + 1);
+    }
     for (std::uint32_t line = 0; line < n; ++line)
         for (std::uint32_t row = 0; row + 2 < m; ++row) add(t->bend, line, row, line, row + 2);
     const std::uint32_t bend_lines = closed ? n : (n >= 2 ? n - 2 : 0);
     if (n > 2)
-        for (std::uint32_t row = 0; row < m; ++row)
-            for (std::uint32_t line = 0; line < bend_lines; ++line) add(t->bend, line, row, (line + 2) % n, row);
+        for (std::uint32_t line = 0; line < bend_lines; ++line)
+            for (std::uint32_t row = 0; row < m; ++row) add(t->bend, line, row, (line + 2) % n, row);
     if (!degenerate.empty()) return fail(std::string(p) + ": " + degenerate);
+    // Each phase in particle order (strips, see above). A warp spring's `a` stays the end
+    // nearer the fitting zone.
+    for (SpringPhase* phase : {&t->warp1, &t->warp2, &t->weft, &t->weft1, &t->shear, &t->bend}) {
+        std::vector<std::uint32_t> order(phase->size());
+        for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+            return std::pair(phase->a[i], phase->b[i]) < std::pair(phase->a[j], phase->b[j]);
+        });
+        SpringPhase sorted;
+        for (std::uint32_t k : order) sorted.add(phase->a[k], phase->b[k], phase->rest_m[k]);
+        *phase = std::move(sorted);
+    }
+
+    // Rest area per particle: a quarter of each grid quad around it (two triangles).
+    t->area_m2 = VectorX::Zero(n * m);
+    for (std::uint32_t line = 0; line < weft_lines; ++line)
+        for (std::uint32_t row = 0; row + 1 < m; ++row) {
+            const std::uint32_t l1 = (line + 1) % n;
+            const Vec3 p00 = pos.col(gi(line, row)), p01 = pos.col(gi(line, row + 1));
+            const Vec3 p10 = pos.col(gi(l1, row)), p11 = pos.col(gi(l1, row + 1));
+            const Real quad = Real(0.5) * ((p11 - p00).cross(p01 - p10)).norm();
+            for (std::uint32_t corner : {at(line, row), at(line, row + 1), at(l1, row), at(l1, row + 1)})
+                t->area_m2[corner] += quad / 4;
+        }
 
     // Weft placement of layer 2 (method §4.2).
     for (std::uint32_t line = 0; line < n; ++line) {
@@ -383,10 +427,16 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
             t->weft_particle.push_back(at(line, row));
             t->weft_left.push_back(at(left, row));
             t->weft_right.push_back(at(right, row));
-            t->weft_t.push_back(Real(line % stride) / Real(stride));
-            Real segments = 0;
-            for (std::uint32_t k = left; k != right; k = (k + 1) % n) segments += rest(k, row, (k + 1) % n, row);
-            t->weft_rest_m.push_back(segments / Real(stride));
+            // Along the chord in proportion to the rest lengths, so that on the chord every
+            // weft segment has the same strain however uneven the segments are.
+            Real segments = 0, before = 0;
+            for (std::uint32_t k = left; k != right; k = (k + 1) % n) {
+                if (k == line) before = segments;
+                segments += rest(k, row, (k + 1) % n, row);
+            }
+            t->weft_t.push_back(before / segments);
+            t->weft_chord_rest_m.push_back(segments);
+            t->weft_rest_m.push_back(std::min(rest((line + n - 1) % n, row, line, row), rest(line, row, (line + 1) % n, row)));
             t->weft_above.push_back(row > 0 ? at(line, row - 1) : std::numeric_limits<std::uint32_t>::max());
             t->weft_above_rest_m.push_back(row > 0 ? rest(line, row - 1, line, row) : Real(0));
         }

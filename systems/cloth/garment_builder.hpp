@@ -52,9 +52,8 @@ struct TubeParams {
 
     /// The paper's skirt: 27 x 31 = 837 particles hung from the waist.
     [[nodiscard]] static TubeParams skirt() { return {}; }
-    /// A dress hung from the shoulders: 120 x 84 = 10,080 particles. Per-spring stiffness
-    /// and per-particle drag are scaled to the finer grid (the same cloth as the skirt per
-    /// unit area), so that the default dress needs one substep too.
+    /// A strapless dress hung from the chest under the arms: 120 x 84 = 10,080 particles, the
+    /// same cloth.
     [[nodiscard]] static TubeParams dress() {
         TubeParams p;
         p.warp_lines = 120;
@@ -62,10 +61,8 @@ struct TubeParams {
         p.length_m = Real(1.05);
         p.flare_deg = Real(10);
         p.ease_m = Real(0.015);
-        p.ring_height_fraction = Real(0.80);
+        p.ring_height_fraction = Real(0.72);  // under the arms: the arms stay outside the dress
         p.fitting_rows = 2;
-        p.material = ClothMaterial{.mass_kg = Real(0.6), .stretch_k_N_m = Real(0.12), .shear_k_N_m = Real(0.06),
-                                   .bend_k_N_m = Real(0.03), .drag_N_s_m = Real(0.00018)};
         p.color = Vec3(0.15f, 0.3f, 0.7f);
         return p;
     }
@@ -81,7 +78,7 @@ struct RectangleParams {
     Vec3 origin = Vec3(0, 2, 0);      ///< Position of line 0, row 0.
     bool hanging = true;              ///< true: rows go down -Y; false: rows go along +Z (horizontal sheet).
     bool pin_top_row = true;          ///< Pin row 0 in world space.
-    ClothMaterial material{.mass_kg = Real(0.1)};
+    ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.8f, 0.8f, 0.8f);

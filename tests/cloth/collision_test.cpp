@@ -108,7 +108,7 @@ test::WalkSettings fast_walk() {
 }
 
 // Walks a garment through a whole walk cycle, calling `check(garment, solver, before)` around
-// every collision pass.
+// every collision round.
 template <class F>
 void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dress = default_skirt,
                 test::WalkSettings walk = {}) {
@@ -121,10 +121,8 @@ void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dr
     test::step_by_hand(
         body, registry, g, solver, frames, test::StageCheck{},
         [&](Garment& garment, GarmentSolver& s, const ClothSubstep& ctx, int) {
-            update_frames(registry, garment.body, s.frames, Real(ctx.index + 1) / Real(ctx.count));
             check(garment, s, /*before=*/true);
-            const CollisionResult r = collide_garment(garment, s, nullptr, static_cast<Real>(ctx.h_s));
-            garment.counters.unresolved += r.unresolved;
+            collide_round(registry, garment, s, ctx, 0);
             check(garment, s, /*before=*/false);
         });
 }

@@ -22,12 +22,12 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
         EXPECT_LT(spec.range.min, spec.range.max) << spec.name;
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
-    // Every ClothMaterial field a garment carries is a row (8 of them), and so is every
+    // Every ClothMaterial field a garment carries is a row (9 of them), and so is every
     // numeric field of TubeParams (10).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
-    EXPECT_EQ(material, 8);
-    EXPECT_EQ(garment_parameters().size(), 18u);
+    EXPECT_EQ(material, 9);
+    EXPECT_EQ(garment_parameters().size(), 19u);
 }
 
 TEST(GarmentParameterTable, SkirtAndDressDefaultsAreValid) {
@@ -52,15 +52,15 @@ TEST(GarmentParameterTable, ValidateNamesTheRowAndItsRange) {
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().message, "dress.ring_height_fraction: must be in (0, 1), got 1");
     p = TubeParams::skirt();
-    find_garment_parameter("strain_iterations")->set(p, 1e6);
-    EXPECT_EQ(validate(p, "skirt").error().message, "skirt.material.strain_iterations: must be in [0, 100], got 1000000");
+    find_garment_parameter("iterations")->set(p, 1e6);
+    EXPECT_EQ(validate(p, "skirt").error().message, "skirt.material.iterations: must be in [1, 100], got 1000000");
     // A material alone (a rectangle's, a running garment's) is checked by the same rows.
     ClothMaterial m;
-    m.shear_k_N_m = -1;
-    EXPECT_EQ(validate(m, "rectangle.material").error().message, "rectangle.material.shear_k_N_m: must be in [0, 1e7] N/m, got -1");
+    m.shear_N_m = -1;
+    EXPECT_EQ(validate(m, "rectangle.material").error().message, "rectangle.material.shear_N_m: must be in [0, 1e7] N/m, got -1");
     m = {};
-    m.drag_N_s_m = std::numeric_limits<Real>::infinity();
-    EXPECT_EQ(validate(m, "material").error().message, "material.drag_N_s_m: must be in [0, 100] N s/m, got inf");
+    m.drag_N_s_m3 = std::numeric_limits<Real>::infinity();
+    EXPECT_EQ(validate(m, "material").error().message, "material.drag_N_s_m3: must be in [0, 100] N s/m^3, got inf");
 }
 
 TEST(GarmentParameterTable, SetRoundsIntegersAndGetReadsBack) {
@@ -69,11 +69,11 @@ TEST(GarmentParameterTable, SetRoundsIntegersAndGetReadsBack) {
     lines.set(p, 29.6);
     EXPECT_EQ(p.warp_lines, 30);
     EXPECT_EQ(lines.get(p), 30);
-    const GarmentParameterSpec& mass = *find_garment_parameter("mass_kg");
-    mass.set(p, 0.5);
-    EXPECT_EQ(p.material.mass_kg, Real(0.5));
-    EXPECT_EQ(mass.get(p.material), 0.5);
-    EXPECT_EQ(mass.field(), "material.mass_kg");
+    const GarmentParameterSpec& density = *find_garment_parameter("areal_density_kg_m2");
+    density.set(p, 0.5);
+    EXPECT_EQ(p.material.areal_density_kg_m2, Real(0.5));
+    EXPECT_EQ(density.get(p.material), 0.5);
+    EXPECT_EQ(density.field(), "material.areal_density_kg_m2");
     EXPECT_EQ(lines.field(), "warp_lines");
 }
 

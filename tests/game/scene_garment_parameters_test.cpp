@@ -125,8 +125,8 @@ TEST_F(SceneGarmentParameters, EveryRangeIsEnforcedByTheSceneFileAndByValidate) 
 
 TEST_F(SceneGarmentParameters, AMisspeltParameterNameIsAnErrorNamingIt) {
     // On line 2 of the file, at the misspelt key.
-    const std::string message = error("skirt", "\"strech_k_N_m\": 2");
-    EXPECT_EQ(message.rfind("scene.json:2:33: garments[0].strech_k_N_m: unknown field (did you mean \"stretch_k_N_m\"?); "
+    const std::string message = error("skirt", "\"strech_N_m\": 2");
+    EXPECT_EQ(message.rfind("scene.json:2:33: garments[0].strech_N_m: unknown field (did you mean \"stretch_N_m\"?); "
                             "known fields: type, character, model, collision, color, particles, warp_lines,",
                             0),
               0u)
