@@ -72,7 +72,8 @@ struct GarmentDescription {
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     std::optional<Vec3> color;                           ///< Linear RGB in [0, 1]; none: the garment's default.
-    std::vector<GarmentParameter> parameters;            ///< Overrides of the builder's defaults, in file order.
+    std::string material;                                ///< A material preset (silk, cotton, denim); empty: cotton.
+    std::vector<GarmentParameter> parameters;            ///< Overrides of the builder's defaults (after the preset), in file order.
     SourceLocation where;                                ///< Of the garment object, for build errors.
     friend bool operator==(const GarmentDescription&, const GarmentDescription&) = default;
 };

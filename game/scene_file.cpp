@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "game/scene_garment_parameters.hpp"
+#include "systems/cloth/garment_parameters.hpp"
 
 namespace drape {
 
@@ -458,6 +459,13 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
         g.collision = read_choice<CollisionMode>(r, f.path("collision"), *v,
                                                  {{"lists", CollisionMode::candidate_lists}, {"brute_force", CollisionMode::brute_force}});
     if (const Json* v = f.get("color")) g.color = read_vec3(r, f.path("color"), *v, 0, 1);
+    if (const Json* v = f.get("material")) {
+        std::string names;
+        for (const MaterialPreset& preset : material_presets()) names += cat(names.empty() ? "\"" : ", \"", preset.name, "\"");
+        if (!v->is_string() || !material_preset(v->get<std::string>()))
+            r.fail_at(f.path("material"), cat("must be one of ", names, ", got ", v->is_string() ? shown(*v) : typed(*v)));
+        g.material = v->get<std::string>();
+    }
     for (const ParameterSpec* spec : scene_garment_parameters()) {
         const Json* v = f.get(spec->name);
         if (v == nullptr) continue;
@@ -664,6 +672,7 @@ std::string to_json(const SceneDescription& scene) {
         o["model"] = cloth_model_name(g.model);
         o["collision"] = collision_mode_name(g.collision);
         if (g.color) o["color"] = vec(*g.color);
+        if (!g.material.empty()) o["material"] = g.material;
         for (const GarmentParameter& p : g.parameters) {
             const auto specs = scene_garment_parameters();
             const auto spec = std::find_if(specs.begin(), specs.end(), [&](const ParameterSpec* s) { return s->name == p.name; });

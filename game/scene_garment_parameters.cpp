@@ -39,6 +39,11 @@ std::vector<const ParameterSpec*> scene_garment_parameters() {
 Result<TubeParams> tube_params(const GarmentDescription& garment) {
     const TubeParams defaults = defaults_of(garment.type);
     TubeParams p = defaults;
+    if (!garment.material.empty()) {
+        auto material = material_preset(garment.material);
+        if (!material) return std::unexpected(material.error());
+        p.material = *material;
+    }
     std::optional<int> particles;
     for (const GarmentParameter& q : garment.parameters) {
         if (q.name == particles_parameter().name) {

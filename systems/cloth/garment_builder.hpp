@@ -45,6 +45,8 @@ struct TubeParams {
     Real ring_height_m = 0;           ///< > 0: ring height above the body's lowest point.
     Real torso_radius_fraction = Real(0.12);  ///< Colliders centred farther than this x height from the axis (arms) are not outline.
     int fitting_rows = 1;             ///< Rows pinned to the body (method §3.5).
+    Real inertia_linear = 1;          ///< InertiaScales::linear of the garment (1: physical).
+    Real inertia_angular = 1;         ///< InertiaScales::angular.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;

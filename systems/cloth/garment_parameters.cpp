@@ -127,6 +127,10 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "colliders farther from the body axis than this x body height (arms) are not part of the outline at the ring"),
         integer("fitting_rows", &TubeParams::fitting_rows, closed(1, max_side - 1),
                 "rows pinned to the body (method §3.5); fewer than `particles_per_line`"),
+        real("inertia_linear", &TubeParams::inertia_linear, closed(0, 1), "",
+             "how much of the body's linear acceleration the cloth feels (method §3.3's -m a_body): 1 physical, 0 carried rigidly"),
+        real("inertia_angular", &TubeParams::inertia_angular, closed(0, 1), "",
+             "how much of the body's turning the cloth feels (centrifugal, Coriolis): 1 physical, 0 carried rigidly"),
         real("areal_density_kg_m2", &ClothMaterial::areal_density_kg_m2, open_min(0, 10), "kg/m^2",
              "mass per area of the cloth (cotton 0.1-0.2, denim 0.3-0.45)"),
         real("stretch_N_m", &ClothMaterial::stretch_N_m, open_min(0, 1e7), "N/m",
@@ -144,6 +148,31 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "candidate lists: reach beyond an ellipsoid's surface (method §5)"),
     };
     return table;
+}
+
+std::span<const MaterialPreset> material_presets() {
+    // Woven fabrics: areal density as sold (g/m^2), stretch moduli of the order a strip test
+    // gives for a woven cloth (force per width per strain), drag per area for still air
+    // around a moving garment (0.5 rho_air C_d |v| at about half a metre per second).
+    static const MaterialPreset presets[] = {
+        {"silk", "light and flowing: 60 g/m^2 charmeuse",
+         ClothMaterial{.areal_density_kg_m2 = Real(0.06), .stretch_N_m = 800, .shear_N_m = 30, .bend_N_m = 2,
+                       .drag_N_s_m3 = Real(0.3), .friction = Real(0.25)}},
+        {"cotton", "the default: 170 g/m^2 poplin", ClothMaterial{}},
+        {"denim", "heavy and stiff: 400 g/m^2 twill",
+         ClothMaterial{.areal_density_kg_m2 = Real(0.4), .stretch_N_m = 8000, .shear_N_m = 600, .bend_N_m = 80,
+                       .drag_N_s_m3 = Real(0.3), .friction = Real(0.5)}},
+    };
+    return presets;
+}
+
+Result<ClothMaterial> material_preset(std::string_view name) {
+    std::string names;
+    for (const MaterialPreset& p : material_presets()) {
+        if (p.name == name) return p.material;
+        names += (names.empty() ? "" : ", ") + std::string(p.name);
+    }
+    return fail("material \"" + std::string(name) + "\": no such preset (presets: " + names + ")");
 }
 
 const GarmentParameterSpec* find_garment_parameter(std::string_view name) {

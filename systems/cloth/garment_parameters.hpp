@@ -19,6 +19,7 @@
 #include <variant>
 
 #include "components/garment.hpp"
+#include "engine/core/error.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
@@ -74,6 +75,19 @@ struct GarmentParameterSpec : ParameterSpec {
 
 /// The table, in the order the docs list it.
 [[nodiscard]] std::span<const GarmentParameterSpec> garment_parameters();
+
+/// A cloth by name, for scene files ("material": "denim") and C++.
+struct MaterialPreset {
+    std::string_view name;
+    std::string_view description;
+    ClothMaterial material;
+};
+
+/// The presets: silk, cotton (the default ClothMaterial), denim.
+[[nodiscard]] std::span<const MaterialPreset> material_presets();
+
+/// The preset called `name`; the error lists the presets there are.
+[[nodiscard]] Result<ClothMaterial> material_preset(std::string_view name);
 
 /// The row called `name`, or null.
 [[nodiscard]] const GarmentParameterSpec* find_garment_parameter(std::string_view name);

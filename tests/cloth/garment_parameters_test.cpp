@@ -23,11 +23,27 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
     // Every ClothMaterial field a garment carries is a row (9 of them), and so is every
-    // numeric field of TubeParams (10).
+    // numeric field of TubeParams (12, the inertia scales included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
     EXPECT_EQ(material, 9);
-    EXPECT_EQ(garment_parameters().size(), 19u);
+    EXPECT_EQ(garment_parameters().size(), 21u);
+}
+
+TEST(MaterialPresets, AreValidDistinctAndFoundByName) {
+    ASSERT_GE(material_presets().size(), 3u);
+    for (const MaterialPreset& preset : material_presets()) {
+        EXPECT_TRUE(validate(preset.material, "material")) << preset.name;
+        auto found = material_preset(preset.name);
+        ASSERT_TRUE(found) << preset.name;
+        EXPECT_EQ(*found, preset.material);
+    }
+    EXPECT_EQ(*material_preset("cotton"), ClothMaterial{});  // the default cloth
+    EXPECT_LT(material_preset("silk")->areal_density_kg_m2, material_preset("denim")->areal_density_kg_m2);
+    EXPECT_LT(material_preset("silk")->stretch_N_m, material_preset("denim")->stretch_N_m);
+    const auto missing = material_preset("tweed");
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().message, "material \"tweed\": no such preset (presets: silk, cotton, denim)");
 }
 
 TEST(GarmentParameterTable, SkirtAndDressDefaultsAreValid) {

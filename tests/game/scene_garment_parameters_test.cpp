@@ -31,7 +31,7 @@ protected:
     }
     void TearDown() override { fs::remove_all(m_dir); }
 
-    // A scene whose only garment (of `type`) has `fields` (JSON members, e.g. "\"mass_kg\": 2").
+    // A scene whose only garment (of `type`) has `fields` (JSON members, e.g. "\"length_m\": 2").
     Result<SceneDescription> load(const std::string& type, const std::string& fields) {
         const fs::path file = m_dir / "scene.json";
         std::ofstream(file, std::ios::binary | std::ios::trunc)
@@ -127,7 +127,7 @@ TEST_F(SceneGarmentParameters, AMisspeltParameterNameIsAnErrorNamingIt) {
     // On line 2 of the file, at the misspelt key.
     const std::string message = error("skirt", "\"strech_N_m\": 2");
     EXPECT_EQ(message.rfind("scene.json:2:33: garments[0].strech_N_m: unknown field (did you mean \"stretch_N_m\"?); "
-                            "known fields: type, character, model, collision, color, particles, warp_lines,",
+                            "known fields: type, character, model, collision, color, material, particles, warp_lines,",
                             0),
               0u)
         << message;
@@ -146,6 +146,21 @@ TEST_F(SceneGarmentParameters, AMisspeltParameterNameIsAnErrorNamingIt) {
     auto params = tube_params(scene.garments[0]);
     ASSERT_FALSE(params);
     EXPECT_EQ(params.error().message, "lenght_m: unknown garment parameter (docs/scenes.md lists them)");
+}
+
+TEST_F(SceneGarmentParameters, AMaterialPresetByNameThenItsFieldsOverridden) {
+    auto scene = load("skirt", "\"material\": \"denim\", \"friction\": 0.2");
+    ASSERT_TRUE(scene) << scene.error().message;
+    auto params = tube_params(scene->garments.at(0));
+    ASSERT_TRUE(params) << params.error().message;
+    ClothMaterial expected = *material_preset("denim");
+    expected.friction = Real(0.2);
+    EXPECT_EQ(params->material, expected);
+    EXPECT_EQ(error("skirt", "\"material\": \"tweed\"").rfind(
+                  "scene.json:2:45: garments[0].material: must be one of \"silk\", \"cotton\", \"denim\", got \"tweed\"", 0),
+              0u)
+        << error("skirt", "\"material\": \"tweed\"");
+    EXPECT_NE(error("skirt", "\"material\": 3").find("garments[0].material: must be one of"), std::string::npos);
 }
 
 TEST_F(SceneGarmentParameters, FormerRingHeightNamesSayTheNewName) {
