@@ -172,7 +172,6 @@ struct GarmentCounters {
     std::uint64_t frame_collision_tests = 0;  ///< Unit-sphere tests this fixed step (all substeps).
     std::uint64_t frame_collisions = 0;       ///< Particle-ellipsoid contacts resolved this step.
     std::uint64_t frame_list_rebuild_tests = 0; ///< Candidate-list (broad phase) tests this step.
-    Real max_strain = 0;                      ///< Largest warp/weft spring length / rest - 1 after constraints, last substep.
     Real max_penetration_m = 0;               ///< Deepest penetration found this step (before response).
     int substeps = 1;                         ///< Substeps of the last fixed step.
     int substeps_stability = 1;               ///< This garment's need from the stability bound (method §3.4).

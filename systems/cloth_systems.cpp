@@ -51,7 +51,6 @@ void run_step(Registry& registry, GarmentBatch& batch, double fixed_dt_s, const 
         timed(1, [&] { run_cloth_constraint_finish(batch, sub); });
         timed(2, [&] { run_cloth_collision_finish(registry, batch, sub); });
     }
-    batch.for_each([](Garment& g, GarmentSolver&) { record_strain(g); });
 }
 
 }  // namespace

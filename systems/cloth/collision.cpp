@@ -744,7 +744,8 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
     alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
     // The particles without slack, gathered without a branch per particle; pinned ones are
     // never tested (method §3.5).
-    std::vector<Eigen::Index> spent(static_cast<std::size_t>(n));
+    std::vector<Eigen::Index>& spent = lists.spent;
+    spent.resize(static_cast<std::size_t>(n));
     std::size_t spent_count = 0;
     for (Eigen::Index begin = 0; begin < n; begin += 16) {
         const Eigen::Index end = std::min<Eigen::Index>(begin + 16, n);

@@ -39,6 +39,7 @@ struct CandidateLists {
     Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
     VectorX slack_m;                         ///< Per particle: how far it may still move before its list could miss a collider, after the last update, m.
     Matrix3XRows scratch;                    ///< Anchor-frame positions, reused every substep.
+    std::vector<Eigen::Index> spent;         ///< Scratch: the particles whose list is refreshed.
 };
 
 struct GarmentSolver {

@@ -161,12 +161,6 @@ void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     }
 }
 
-void record_strain(Garment& g) {
-    const Fabric& t = *g.fabric;
-    const Matrix3X& x = g.state.x;
-    g.counters.max_strain = std::max({max_strain(t.warp1, x), max_strain(t.warp2, x), max_strain(t.weft, x)});
-}
-
 std::uint64_t count_non_finite(const Garment& g) {
     return static_cast<std::uint64_t>((!g.state.x.array().isFinite()).count() + (!g.state.v.array().isFinite()).count());
 }
@@ -212,7 +206,6 @@ int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double 
             finish_collision(registry, g, s, sub);
         if (hooks.after_collision) hooks.after_collision(g, s, sub);
     }
-    record_strain(g);
     return substeps;
 }
 

@@ -16,7 +16,6 @@
 //                             the substep's move without the push-outs, then contacts (no
 //                             approach, friction)
 //     finish_collision        cloth_collision: the non-finite check
-//   record_strain after the last substep.
 #pragma once
 
 #include <functional>
@@ -69,9 +68,6 @@ void finish_collision(const Registry& registry, Garment& garment, GarmentSolver&
 
 /// Constraint rounds per substep of the garment's material.
 [[nodiscard]] int constraint_rounds(const Garment& garment) noexcept;
-
-/// Records the largest warp/weft strain in the garment's counters (after the last substep).
-void record_strain(Garment& garment);
 
 /// Hooks for stepping by hand: each, when set, is called with the substep.
 struct StepHooks {
