@@ -67,7 +67,7 @@ Result<World> sweep_world(ClothModel model, int substeps, int iterations, Collis
     spec.threads = threads;
     auto world = build_bench_world(spec);
     if (!world) return world;
-    first_garment(*world).config.material.strain_iterations = iterations;
+    first_garment(*world).config.material.iterations = iterations;
     return world;
 }
 
@@ -168,15 +168,15 @@ Result<OscillatorRow> oscillator(double steps_per_period) {
     p.weft_stride = 1;
     p.width_m = 0.1f;
     p.length_m = 1;
-    p.material.mass_kg = 0.4f;          // 0.1 kg per particle
-    p.material.stretch_k_N_m = 40;
-    p.material.drag_N_s_m = 0;
+    p.material.areal_density_kg_m2 = 4;  // 0.025 m^2 per particle: 0.1 kg
+    p.material.stretch_N_m = 1600;        // k = 1600 x (0.025 + 0.025) / (2 x 1 m^2) = 40 N/m
+    p.material.drag_N_s_m3 = 0;
     p.material.strain_limit = 10;       // the largest allowed: Provot must not hold the oscillator
     auto garment = make_rectangle(p);
     if (!garment) return fail("oscillator: " + garment.error().message);
     const std::uint32_t free = garment->fabric->grid[1];   // line 0, row 1
     const double m = 1.0 / garment->state.inv_mass[free];
-    const double k = p.material.stretch_k_N_m;
+    const double k = 40;
     const double omega = std::sqrt(k / m);
     const double period = 2 * std::numbers::pi / omega;
     const double h = period / steps_per_period;
@@ -240,9 +240,9 @@ Result<ChainRow> hanging_chain(int particles) {
     p.length_m = 1;
     p.hanging = false;                           // rows along +Z
     p.origin = Vec3(0, 2, 0);
-    p.material.mass_kg = 0.2f;                   // 0.1 kg per chain
-    p.material.stretch_k_N_m = static_cast<Real>(1000.0 * 40 / (particles - 1));   // same chain stiffness EA
-    p.material.drag_N_s_m = 0.004f;
+    p.material.areal_density_kg_m2 = 4;          // 0.05 m^2: 0.1 kg per chain
+    p.material.stretch_N_m = 1000;               // the same chain stiffness EA for every particle count
+    p.material.drag_N_s_m3 = 0.004f * 4 / 0.05f * static_cast<Real>(particles) / 40;
     auto garment = make_rectangle(p);
     if (!garment) return fail("chain: " + garment.error().message);
     const double span = 0.8;
@@ -303,7 +303,7 @@ Result<void> run_error(const BenchOptions& options) {
                     if (!row) return fail("error: " + row.error().message);
                     rows.push_back(*row);
                 }
-    const int default_iterations = ClothMaterial{}.strain_iterations;
+    const int default_iterations = ClothMaterial{}.iterations;
     auto default_row = measure({ClothModel::simplified, 0, default_iterations, CollisionMode::candidate_lists}, *reference,
                                options.threads);
     if (!default_row) return fail("error: " + default_row.error().message);

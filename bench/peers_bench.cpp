@@ -94,7 +94,7 @@ Result<Run> alternate(const BulletTuning& tuning, int frames, bool stop_bullet_o
     const auto structural = structural_springs(*g0.fabric);
     cloth.springs = structural.springs;
     cloth.pinned = pinned_particles(g0);
-    cloth.mass_kg = g0.config.material.mass_kg / static_cast<Real>(g0.state.x.cols());
+    cloth.mass_kg = g0.config.material.areal_density_kg_m2 * g0.fabric->area_m2.mean();
     auto bullet = BulletCloth::create(cloth, collider_worlds(world->registry, g0), tuning);
     if (!bullet) return fail(bullet.error().message);
 

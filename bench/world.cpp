@@ -3,6 +3,9 @@
 
 #include <cmath>
 
+#include "game/asset_paths.hpp"
+#include "game/sample_scene.hpp"
+
 namespace drape::bench {
 
 SceneDescription scene_for(const WorldSpec& spec) {

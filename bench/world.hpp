@@ -6,7 +6,7 @@
 
 #include "components/garment.hpp"
 #include "engine/core/error.hpp"
-#include "game/scene.hpp"
+#include "game/world.hpp"
 
 namespace drape::bench {
 

@@ -19,9 +19,9 @@
 //   particles, so the simplified model integrates one contiguous block.
 // - Springs are flat parallel index arrays (`SpringPhase`). Warp springs are listed line by
 //   line from the fitting zone outward: `a` is the end nearer the pins.
-// - `inv_mass` is the same in both models (total mass / particle count, 0 = pinned). In the
-//   simplified model a layer-1 particle carries the mass, drag and spring stiffness of the
-//   weft particles it stands for (`layer1_mass_scale`).
+// - `inv_mass` is the same in both models (1 / (areal density x area), 0 = pinned). In the
+//   simplified model a layer-1 particle carries the mass and drag of the weft particles
+//   placed from it, by their weights.
 // The render system reads only `state.x`, `fabric->triangles` and `config.color`.
 #pragma once
 
@@ -67,6 +67,7 @@ struct Fabric {
 
     std::vector<std::uint32_t> grid;        ///< Particle index of (line, row): grid[line * m + row].
     std::vector<std::uint8_t> layer;        ///< 1 or 2 per particle.
+    VectorX area_m2;                        ///< Per particle: the rest area it stands for (a quarter of each quad around it).
     std::vector<std::uint32_t> triangles;   ///< Render triangles over the particle grid.
 
     // Layer-1 springs (method §3.2, §4.1).
@@ -83,8 +84,10 @@ struct Fabric {
     std::vector<std::uint32_t> weft_particle;  ///< The layer-2 particle.
     std::vector<std::uint32_t> weft_left;      ///< Its layer-1 neighbour before it along the weft.
     std::vector<std::uint32_t> weft_right;     ///< Its layer-1 neighbour after it.
-    std::vector<Real> weft_t;                  ///< Fraction of the way from left to right, (0, 1).
-    std::vector<Real> weft_rest_m;             ///< Mean rest length of the weft segments from left to right.
+    std::vector<Real> weft_t;                  ///< Its place on the chord from left to right, (0, 1): the rest length
+                                               ///< of the weft segments before it over that of the whole chord.
+    std::vector<Real> weft_chord_rest_m;       ///< Rest length of the weft segments from left to right.
+    std::vector<Real> weft_rest_m;             ///< The shorter rest length of its two weft segments.
     std::vector<std::uint32_t> weft_above;     ///< The particle before it on its warp line (nearer the pins), or UINT32_MAX.
     std::vector<Real> weft_above_rest_m;       ///< Rest length of that warp spring.
     // Normal stencil of each layer-1 particle: n = (x[up] - x[down]) x (x[next] - x[prev]).
@@ -93,17 +96,30 @@ struct Fabric {
     [[nodiscard]] std::size_t particle_count() const noexcept { return layer.size(); }
 };
 
-/// Material and solver settings of one garment instance.
+/// The cloth in physical units (method §3.3, §4.1). Moduli are those of the sheet: force per
+/// unit width per unit strain. A spring of the grid gets k = modulus x (A_a + A_b) / (2 L^2)
+/// with A the rest areas its two particles stand for and L its rest length, so a finer grid
+/// or a layer-1 spring standing for several lines is the same cloth.
 struct ClothMaterial {
-    Real mass_kg = Real(0.35);              ///< Whole garment.
-    Real stretch_k_N_m = Real(0.9);         ///< Per stretch spring of the full grid.
-    Real shear_k_N_m = Real(0.45);          ///< Classic only.
-    Real bend_k_N_m = Real(0.2);            ///< Classic only.
-    Real drag_N_s_m = Real(0.0012);         ///< Air drag per particle of the full grid (method §3.3 k).
+    Real areal_density_kg_m2 = Real(0.17);  ///< Mass per area (cotton lawn / poplin: 0.1-0.2).
+    Real stretch_N_m = Real(2000);          ///< Stretch modulus of warp and weft.
+    Real shear_N_m = Real(100);             ///< Classic only: shear springs' modulus.
+    Real bend_N_m = Real(10);               ///< Classic only: bend springs' modulus.
+    Real drag_N_s_m3 = Real(0.3);           ///< Air drag per area per speed (method §3.3 k = this x particle area).
+    Real friction = Real(0.4);              ///< Coulomb coefficient of the cloth on the body.
     Real strain_limit = Real(0.10);         ///< Provot: max relative over-stretch (method §4.1).
-    int strain_iterations = 2;              ///< Symmetric Provot passes before the ordered pass.
+    int iterations = 4;                     ///< Constraint rounds per substep.
     Real candidate_margin_m = Real(0.08);   ///< Candidate lists: reach beyond the surface (method §5).
     friend bool operator==(const ClothMaterial&, const ClothMaterial&) = default;
+};
+
+/// How much of the anchor's own motion the particles feel (method §3.3's inertial term):
+/// 1 is physical; 0 carries the garment rigidly with the body part it hangs from, so a
+/// game can tame a hard turn or a jerk.
+struct InertiaScales {
+    Real linear = 1;   ///< Of the anchor's linear acceleration.
+    Real angular = 1;  ///< Of its rotation (centrifugal and Coriolis terms).
+    friend bool operator==(const InertiaScales&, const InertiaScales&) = default;
 };
 
 /// Per-instance configuration. Read freely; change `model` and `material` through
@@ -112,6 +128,7 @@ struct GarmentConfig {
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     ClothMaterial material;
+    InertiaScales inertia;
     Vec3 color = Vec3(0.75f, 0.12f, 0.18f);  ///< Linear RGB.
     friend bool operator==(const GarmentConfig&, const GarmentConfig&) = default;
 };
@@ -155,7 +172,6 @@ struct GarmentCounters {
     std::uint64_t frame_collision_tests = 0;  ///< Unit-sphere tests this fixed step (all substeps).
     std::uint64_t frame_collisions = 0;       ///< Particle-ellipsoid contacts resolved this step.
     std::uint64_t frame_list_rebuild_tests = 0; ///< Candidate-list (broad phase) tests this step.
-    Real max_strain = 0;                      ///< Largest warp/weft spring length / rest - 1 after constraints, last substep.
     Real max_penetration_m = 0;               ///< Deepest penetration found this step (before response).
     int substeps = 1;                         ///< Substeps of the last fixed step.
     int substeps_stability = 1;               ///< This garment's need from the stability bound (method §3.4).

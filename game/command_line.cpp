@@ -1,5 +1,5 @@
-// The `drape` command line: value checks with Drape-style messages, and one line per
-// command-line error (CLI11 prints two and exits 105-ish codes of its own).
+// The `drape` command line: exit status and errors, value checks with Drape-style messages,
+// and one line per command-line error (CLI11 prints two and exits 105-ish codes of its own).
 
 // GCC 12 with the sanitizers warns inside libstdc++'s <regex> (the std::function in its
 // automaton's states: -Wmaybe-uninitialized, a false positive); the standard headers are
@@ -18,7 +18,7 @@
 #include <vector>
 #pragma GCC diagnostic pop
 
-#include "game/commands.hpp"
+#include "game/command_line.hpp"
 
 namespace drape {
 namespace {
@@ -85,6 +85,17 @@ std::string one_line(const CLI::ParseError& e, const CLI::App& app, bool top_lev
 }
 
 }  // namespace
+
+int& command_exit_code() {
+    static int code = 0;
+    return code;
+}
+
+int command_error(std::string_view command, const std::string& message) {
+    std::fprintf(stderr, "drape %.*s: %s\n", static_cast<int>(command.size()), command.data(), message.c_str());
+    command_exit_code() = exit_bad_input;
+    return exit_bad_input;
+}
 
 CLI::Validator integer_in(long long min, long long max) {
     const std::string range = "[" + std::to_string(min) + ", " + std::to_string(max) + "]";

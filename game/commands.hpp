@@ -1,15 +1,11 @@
 // Subcommands of the `drape` command. Each lives in its own file and adds itself to the
-// command line; main() runs the one the user chose.
-//
-// Exit codes of every subcommand: 0 done; 1 bad input (a command-line value, a scene or
-// character file, a name that does not exist, an output that would overwrite a file) or a
-// run that failed (one line on stderr says which); `--help` exits 0.
+// command line; main() runs the one the user chose. What they share (exit codes, errors,
+// value checks) is in game/command_line.hpp, how they write files in game/output_files.hpp.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include <CLI/CLI.hpp>
+
+#include "game/command_line.hpp"
 
 namespace drape {
 
@@ -25,24 +21,7 @@ void add_make_avatar_command(CLI::App& app);
 /// `drape bench NAME`: benchmarks and reports (bench/).
 void add_bench_command(CLI::App& app);
 
-/// Exit code of the subcommand that ran (set by its callback).
-int& command_exit_code();
-
-/// Exit code for bad input and failed runs, the same for every subcommand.
-inline constexpr int exit_bad_input = 1;
-
-/// Command-line checks whose messages read like Drape's other errors; CLI11 puts the
-/// option in front: "--frames: must be an integer in [1, 10000000], got -3". Non-numbers,
-/// NaN and infinities are refused with the same line.
-[[nodiscard]] CLI::Validator integer_in(long long min, long long max);
-[[nodiscard]] CLI::Validator number_in(double min, double max);
-/// One of `choices`: "--garment: must be one of skirt, dress, none, got \"hat\"".
-[[nodiscard]] CLI::Validator one_of(std::vector<std::string> choices);
-/// A file name, folder or clip that is not empty ("--scene \"$SCENE\"" with SCENE unset).
-[[nodiscard]] CLI::Validator not_empty();
-
-/// Parses and runs the command line. A command-line error is one line on stderr
-/// ("drape play: --frames: must be ...") and returns exit_bad_input; help returns 0.
-[[nodiscard]] int run_command_line(CLI::App& app, int argc, const char* const* argv);
+/// `drape scene-parameters`: the garment parameters of scene files, as docs/scenes.md lists them.
+void add_scene_parameters_command(CLI::App& app);
 
 }  // namespace drape

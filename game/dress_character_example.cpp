@@ -14,11 +14,12 @@
 #include "engine/assets/character_import.hpp"
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
 #include "systems/character/character_systems.hpp"
 #include "systems/character/spawn.hpp"
 #include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"
+#include "systems/cloth/garment_quality.hpp"
 
 namespace {
 
@@ -72,7 +73,7 @@ int main(int argc, char** argv) {
     // 4. The skirt: a cone hung from the fitted hip ellipsoids, top row pinned to the skin.
     //    The builder fits around placed colliders: one skinning pass places them.
     scheduler.run_phase(registry, drape::Phase::skinning, drape::FrameContext{.fixed_dt_s = 1.0 / 60.0});
-    drape::SkirtParams skirt;  // 27 x 31 = 837 particles, the paper's skirt
+    const drape::TubeParams skirt = drape::TubeParams::skirt();  // 27 x 31 = 837 particles, the paper's skirt
     auto garment = drape::attach_skirt(registry, *character, skirt);
     if (!garment) return fail_with(garment.error().message);
 
@@ -85,7 +86,7 @@ int main(int argc, char** argv) {
     const bool finite = g.state.x.allFinite() && g.state.v.allFinite();
     const int inside = particles_inside(registry, g);
     std::printf("%s: %lld particles, lowest at %.3f m, max strain %.3f, %d inside an ellipsoid, %s\n", file.c_str(),
-                static_cast<long long>(g.state.x.cols()), finite ? double(g.state.x.row(1).minCoeff()) : 0.0, double(g.counters.max_strain),
+                static_cast<long long>(g.state.x.cols()), finite ? double(g.state.x.row(1).minCoeff()) : 0.0, double(measure_garment(registry, g).strain_max),
                 inside, finite ? "all finite" : "NON-FINITE VALUES");
     return finite && inside == 0 ? 0 : 1;
 }

@@ -34,8 +34,7 @@ void add_inspect_command(CLI::App& app) {
         options.require_animation = !o->allow_static;
         auto character = import_character(o->file, options);
         if (!character) {
-            std::fprintf(stderr, "drape inspect: %s\n", character.error().message.c_str());
-            command_exit_code() = 1;
+            command_error("inspect", character.error().message);
             return;
         }
         for (const std::string& warning : (*character)->warnings) std::fprintf(stderr, "drape inspect: warning: %s\n", warning.c_str());

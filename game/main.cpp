@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
 #ifdef DRAPE_HAVE_BENCH
     drape::add_bench_command(app);
 #endif
+    drape::add_scene_parameters_command(app);
     // No subcommand: play the sample scene.
     std::vector<const char*> args(argv, argv + argc);
     if (argc == 1) args.push_back("play");

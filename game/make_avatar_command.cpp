@@ -38,10 +38,7 @@ void add_make_avatar_command(CLI::App& app) {
     command->add_option("--out", o->out, "Where to write the .glb file")->capture_default_str();
     command->add_flag("--overwrite", o->overwrite, "Replace FILE if it exists with other contents (else: an error)");
     command->callback([o] {
-        auto error = [](const std::string& message) {
-            std::fprintf(stderr, "drape make-avatar: %s\n", message.c_str());
-            command_exit_code() = exit_bad_input;
-        };
+        auto error = [](const std::string& message) { command_error("make-avatar", message); };
         const std::filesystem::path out = o->out;
         const AvatarModel model = make_default_avatar();
         auto bytes = avatar_glb(model);

@@ -9,7 +9,9 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "engine/core/error.hpp"
 
@@ -25,5 +27,43 @@ namespace drape {
 
 /// Renames the complete `partial` onto `file` (replacing it); removes `partial` on failure.
 [[nodiscard]] Result<void> commit_partial(const std::filesystem::path& partial, const std::filesystem::path& file);
+
+/// A path under `folder` named stem + extension, or stem-2 + extension, stem-3 ..., the
+/// first that does not exist yet: the outputs Drape names itself never overwrite anything.
+[[nodiscard]] std::filesystem::path fresh_path(const std::filesystem::path& folder, const std::string& stem,
+                                               const std::string& extension);
+
+/// Name of frame `index` in a frame folder (`drape play --out DIR`): "frame_00000.png".
+[[nodiscard]] std::string frame_file_name(int index);
+
+/// The frame files (frame_NNNNN.png) in `folder`, in no particular order; none when it
+/// cannot be read.
+[[nodiscard]] std::vector<std::filesystem::path> frame_files(const std::filesystem::path& folder);
+
+/// Removes the frame files of `folder` numbered `count` and above (an older, longer run's),
+/// so that it holds one run's frames.
+void remove_frames_from(const std::filesystem::path& folder, int count);
+
+/// Everything a run creates (folders, frames), removed again unless the run completes
+/// (keep()): a run that fails leaves nothing behind and never removes what existed
+/// before it.
+class CreatedOutputs {
+public:
+    CreatedOutputs() = default;
+    CreatedOutputs(const CreatedOutputs&) = delete;
+    CreatedOutputs& operator=(const CreatedOutputs&) = delete;
+    ~CreatedOutputs();
+
+    /// Creates `folder` and its missing parents, remembering each one it made.
+    [[nodiscard]] Result<void> create_folder(const std::filesystem::path& folder);
+    /// Remembers a file the run is about to write.
+    void add_file(const std::filesystem::path& file) { m_files.push_back(file); }
+    /// The run completed: keep everything.
+    void keep() { m_kept = true; }
+
+private:
+    std::vector<std::filesystem::path> m_files, m_folders;
+    bool m_kept = false;
+};
 
 }  // namespace drape

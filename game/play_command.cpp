@@ -1,12 +1,12 @@
 // `drape play`: builds a scene (the sample scene by default), runs it for a number of
 // frames, writes what was asked (PNG frames, a video, a trace, stats) and prints the frame
 // budget. Usage and options: README.md "Playing scenes" and `drape play --help`.
-
-// GCC 12 with the sanitizers warns inside libstdc++'s <regex> (the std::function in its
-// automaton's states: -Wmaybe-uninitialized, a false positive); the standard headers are
-// read with that warning off.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+//
+// play() is a sequence of steps, each a function below: check the options, load the scene,
+// apply the command-line overrides, build the world, open the outputs, run the frames,
+// close the outputs, print the budget, write the reports. Nothing is written before every
+// input has been checked and the world is built; a step that fails prints one line and
+// leaves nothing the run created behind (CreatedOutputs, game/output_files.hpp).
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -14,31 +14,26 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
-#include <regex>
 #include <string>
 #include <thread>
 #include <tuple>
 #include <vector>
-#pragma GCC diagnostic pop
 
 #include <unistd.h>
 
 #include "game/commands.hpp"
 #include "game/output_files.hpp"
-#include "game/scene.hpp"
+#include "game/sample_scene.hpp"
+#include "game/scene_file.hpp"
 #include "game/stats.hpp"
 #include "game/video.hpp"
+#include "game/world.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
 #include "engine/render/renderer.hpp"
 #endif
 
 namespace drape {
-
-int& command_exit_code() {
-    static int code = 0;
-    return code;
-}
 
 namespace {
 
@@ -58,60 +53,7 @@ volatile std::sig_atomic_t g_interrupted = 0;
 void on_interrupt(int) { g_interrupted = 1; }
 
 // Errors of this command: "drape play: --size: must be WxH ..." on stderr, exit code 1.
-int report(const std::string& message) {
-    std::fprintf(stderr, "drape play: %s\n", message.c_str());
-    command_exit_code() = exit_bad_input;
-    return exit_bad_input;
-}
-
-// The frames `--out DIR` writes: frame_00000.png, frame_00001.png, ...
-bool is_frame_file(const fs::path& file) {
-    static const std::regex name(R"(frame_\d{5}\.png)");
-    return std::regex_match(file.filename().string(), name);
-}
-
-std::vector<fs::path> frame_files(const fs::path& folder) {
-    std::vector<fs::path> out;
-    std::error_code ec;
-    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
-        if (is_frame_file(it->path())) out.push_back(it->path());
-    return out;
-}
-
-// Everything this run creates (folders, frames), removed again unless the run completes:
-// a run that fails leaves nothing behind and never removes what existed before it.
-class CreatedOutputs {
-public:
-    CreatedOutputs() = default;
-    CreatedOutputs(const CreatedOutputs&) = delete;
-    CreatedOutputs& operator=(const CreatedOutputs&) = delete;
-    ~CreatedOutputs() {
-        if (m_kept) return;
-        std::error_code ec;
-        for (const fs::path& f : m_files) fs::remove(f, ec);
-        for (auto it = m_folders.rbegin(); it != m_folders.rend(); ++it) fs::remove(*it, ec);  // only when empty
-    }
-    // Creates `folder` and its missing parents, remembering each one it made.
-    Result<void> create_folder(const fs::path& folder) {
-        std::vector<fs::path> missing;
-        std::error_code ec;
-        for (fs::path p = folder; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-            missing.push_back(p);
-            if (p == p.parent_path()) break;
-        }
-        for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-            if (!fs::create_directory(*it, ec) && ec) return fail(it->string() + ": cannot create the folder: " + ec.message());
-            m_folders.push_back(*it);
-        }
-        return {};
-    }
-    void add_file(const fs::path& file) { m_files.push_back(file); }
-    void keep() { m_kept = true; }
-
-private:
-    std::vector<fs::path> m_files, m_folders;
-    bool m_kept = false;
-};
+int report(const std::string& message) { return command_error("play", message); }
 
 Result<std::pair<int, int>> parse_size(const std::string& text) {
     int w = 0, h = 0;
@@ -124,16 +66,84 @@ Result<std::pair<int, int>> parse_size(const std::string& text) {
     return std::pair{w, h};
 }
 
-// A path under `folder` named stem + n + extension that does not exist yet: default
-// outputs never overwrite anything.
-fs::path fresh_path(const fs::path& folder, const std::string& stem, const std::string& extension) {
-    std::error_code ec;
-    for (int n = 1;; ++n) {
-        fs::path p = folder / (n == 1 ? stem + extension : stem + "-" + std::to_string(n) + extension);
-        if (!fs::exists(p, ec)) return p;
+// ---------------------------------------------------------------------------------------
+// 1. Options: what needs no scene. Option ranges, NaN included, are checked by the
+//    command line's validators.
+
+/// What the options come to.
+struct PlaySettings {
+    std::pair<int, int> size{1280, 720};  ///< Frame size, px.
+    bool headless = false;                ///< Nothing rendered (asked for, or no render module).
+    bool window = false;                  ///< In an X11 window.
+};
+
+Result<PlaySettings> check_options(const PlayOptions& o) {
+    PlaySettings s;
+    if (!o.size.empty()) {
+        auto size = parse_size(o.size);
+        if (!size) return std::unexpected(size.error());
+        s.size = *size;
     }
+    if (o.headless) {
+        if (o.window) return fail("--headless: cannot be combined with --window (nothing is rendered)");
+        if (!o.out.empty()) return fail("--headless: cannot be combined with --out (nothing is rendered)");
+        if (!o.video.empty()) return fail("--headless: cannot be combined with --video (nothing is rendered)");
+    }
+    s.headless = o.headless;
+    if (!render_available()) {
+        if (o.window) return fail("--window: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
+        if (!o.out.empty()) return fail("--out: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
+        if (!o.video.empty()) return fail("--video: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
+        if (!s.headless) std::printf("drape play: the render module is not built (-DDRAPE_RENDER=OFF): playing headless\n");
+        s.headless = true;
+    }
+    s.window = o.window && !s.headless;
+    if (!o.video.empty() && !find_ffmpeg())
+        return fail("--video: ffmpeg is not installed (apt-get install ffmpeg); --out DIR writes PNG frames instead");
+    if (!o.out.empty()) {
+        std::error_code ec;
+        if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) return fail("--out: " + o.out + " exists and is not a folder");
+        if (!o.overwrite && fs::is_directory(o.out, ec) && !frame_files(o.out).empty())
+            return fail("--out: " + o.out + " already holds frames (frame_00000.png, ...); add --overwrite to replace them");
+    }
+    if (!s.headless && !o.window && o.video.empty() && o.out.empty()) {  // the default output goes under out/
+        std::error_code ec;
+        if (fs::exists("out", ec) && !fs::is_directory("out", ec))
+            return fail("out: exists and is not a folder (the default output goes there; name one with --video or --out)");
+    }
+    const std::array<std::pair<const char*, std::string>, 3> files{
+        {{"--stats", o.stats}, {"--trace", o.trace}, {"--video", o.video}}};
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        const auto& [name, file] = files[i];
+        if (file.empty()) continue;
+        std::error_code ec;
+        const fs::path folder = fs::path(file).parent_path();
+        if (!folder.empty() && !fs::is_directory(folder, ec))
+            return fail(std::string(name) + ": folder " + folder.string() + " does not exist");
+        if (::access(folder.empty() ? "." : folder.c_str(), W_OK) != 0)
+            return fail(std::string(name) + ": folder " + (folder.empty() ? std::string(".") : folder.string()) + " is not writable");
+        if (auto ok = check_new_file(name, file, o.overwrite); !ok) return std::unexpected(ok.error());
+        for (std::size_t k = 0; k < i; ++k)
+            if (!files[k].second.empty() && fs::path(files[k].second).lexically_normal() == fs::path(file).lexically_normal())
+                return fail(std::string(name) + ": " + file + " is also the " + files[k].first + " file");
+    }
+    return s;
 }
 
+// ---------------------------------------------------------------------------------------
+// 2. The scene: the file named, or the sample scene.
+Result<SceneDescription> load_scene(const PlayOptions& o) {
+    if (!o.scene.empty()) return load_scene_file(o.scene);
+    SceneDescription scene = sample_scene();
+    std::error_code ec;
+    if (o.character.empty() && !fs::exists(scene.characters.at(0).file, ec))
+        return fail("the sample scene's avatar is missing: " + scene.characters[0].file.string() +
+                    " (run from the project folder, or set DRAPE_ASSETS to its assets/ folder)");
+    return scene;
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. Command-line overrides of the scene, then the scene checked as a whole.
 // Applies the command-line overrides to a scene.
 Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
     if (!o.character.empty()) {
@@ -172,81 +182,19 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
     return {};
 }
 
-int play(const PlayOptions& o) {
-    // --- Checks that need no scene; nothing is written before every input is checked.
-    // (Option ranges, NaN included, are checked by the command line's validators.)
-    std::pair<int, int> size{1280, 720};
-    if (!o.size.empty()) {
-        auto s = parse_size(o.size);
-        if (!s) return report(s.error().message);
-        size = *s;
-    }
-    if (o.headless) {
-        if (o.window) return report("--headless: cannot be combined with --window (nothing is rendered)");
-        if (!o.out.empty()) return report("--headless: cannot be combined with --out (nothing is rendered)");
-        if (!o.video.empty()) return report("--headless: cannot be combined with --video (nothing is rendered)");
-    }
-    bool headless = o.headless;
-    if (!render_available()) {
-        if (o.window) return report("--window: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
-        if (!o.out.empty()) return report("--out: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
-        if (!o.video.empty()) return report("--video: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
-        if (!headless) std::printf("drape play: the render module is not built (-DDRAPE_RENDER=OFF): playing headless\n");
-        headless = true;
-    }
-    if (!o.video.empty() && !find_ffmpeg())
-        return report("--video: ffmpeg is not installed (apt-get install ffmpeg); --out DIR writes PNG frames instead");
-    if (!o.out.empty()) {
-        std::error_code ec;
-        if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) return report("--out: " + o.out + " exists and is not a folder");
-        if (!o.overwrite && fs::is_directory(o.out, ec) && !frame_files(o.out).empty())
-            return report("--out: " + o.out + " already holds frames (frame_00000.png, ...); add --overwrite to replace them");
-    }
-    if (!headless && !o.window && o.video.empty() && o.out.empty()) {  // the default output goes under out/
-        std::error_code ec;
-        if (fs::exists("out", ec) && !fs::is_directory("out", ec))
-            return report("out: exists and is not a folder (the default output goes there; name one with --video or --out)");
-    }
-    const std::array<std::pair<const char*, std::string>, 3> files{
-        {{"--stats", o.stats}, {"--trace", o.trace}, {"--video", o.video}}};
-    for (std::size_t i = 0; i < files.size(); ++i) {
-        const auto& [name, file] = files[i];
-        if (file.empty()) continue;
-        std::error_code ec;
-        const fs::path folder = fs::path(file).parent_path();
-        if (!folder.empty() && !fs::is_directory(folder, ec))
-            return report(std::string(name) + ": folder " + folder.string() + " does not exist");
-        if (::access(folder.empty() ? "." : folder.c_str(), W_OK) != 0)
-            return report(std::string(name) + ": folder " + (folder.empty() ? std::string(".") : folder.string()) + " is not writable");
-        if (auto ok = check_new_file(name, file, o.overwrite); !ok) return report(ok.error().message);
-        for (std::size_t k = 0; k < i; ++k)
-            if (!files[k].second.empty() && fs::path(files[k].second).lexically_normal() == fs::path(file).lexically_normal())
-                return report(std::string(name) + ": " + file + " is also the " + files[k].first + " file");
-    }
+Result<void> apply_command_line(SceneDescription& scene, const PlayOptions& o) {
+    if (auto ok = apply_overrides(scene, o); !ok) return ok;
+    return validate(scene);
+}
 
-    // --- The scene.
-    SceneDescription scene;
-    if (!o.scene.empty()) {
-        auto loaded = load_scene_file(o.scene);
-        if (!loaded) return report(loaded.error().message);
-        scene = std::move(*loaded);
-    } else {
-        scene = sample_scene();
-        std::error_code ec;
-        if (o.character.empty() && !fs::exists(scene.characters.at(0).file, ec))
-            return report("the sample scene's avatar is missing: " + scene.characters[0].file.string() +
-                          " (run from the project folder, or set DRAPE_ASSETS to its assets/ folder)");
-    }
-    if (auto ok = apply_overrides(scene, o); !ok) return report(ok.error().message);
-    if (auto ok = validate(scene); !ok) return report(ok.error().message);
-
-    // --- The world (nothing has been written yet).
-    const bool window = o.window && !headless;
+// ---------------------------------------------------------------------------------------
+// 4. The world (nothing has been written yet).
+Result<World> build_play_world(const SceneDescription& scene, const PlayOptions& o, const PlaySettings& s) {
     WorldOptions options;
-    options.render = !headless;
-    options.window = window;
-    options.width = size.first;
-    options.height = size.second;
+    options.render = !s.headless;
+    options.window = s.window;
+    options.width = s.size.first;
+    options.height = s.size.second;
     auto built = build_world(scene, options);
     if (!built) {
         // A value from the command line is named as the option the user typed.
@@ -254,156 +202,241 @@ int play(const PlayOptions& o) {
         for (const auto& [field, option, given] : {std::tuple{"characters[0].clip: ", "--clip: ", !o.clip.empty()},
                                                    std::tuple{"characters[0].file: ", "--character: ", !o.character.empty()}})
             if (given && message.rfind(field, 0) == 0) message = option + message.substr(std::string_view(field).size());
-        return report(message);
+        return fail(message);
     }
-    World& world = *built;
-    for (const std::string& warning : world.warnings) std::fprintf(stderr, "drape play: warning: %s\n", warning.c_str());
+    for (const std::string& warning : built->warnings) std::fprintf(stderr, "drape play: warning: %s\n", warning.c_str());
+    return built;
+}
 
-    // --- Where frames go, created only now that the input is known good. Off-screen with
-    // no output named: a new video (or frame folder) under out/, never over an old one.
-    CreatedOutputs created;
-    fs::path video_file = o.video, frame_folder = o.out;
-    if (!headless && !window && o.video.empty() && o.out.empty()) {
-        const std::string stem = o.scene.empty() ? (o.character.empty() ? "sample" : fs::path(o.character).stem().string())
-                                                 : fs::path(o.scene).stem().string();
-        if (auto ok = created.create_folder("out"); !ok) return report("out/: " + ok.error().message);
-        if (find_ffmpeg())
-            video_file = fresh_path("out", stem, ".mp4");
-        else
-            frame_folder = fresh_path("out", stem + "_frames", "");
-    }
-    if (!frame_folder.empty())
-        if (auto ok = created.create_folder(frame_folder); !ok) return report("--out: " + ok.error().message);
+// ---------------------------------------------------------------------------------------
+// 5. Outputs: where frames go, created only now that the input is known good. Off-screen
+//    with no output named: a new video (or frame folder) under out/, never over an old one.
 
-    const int frames = o.frames.value_or(window ? 0 : 240);  // window: until closed unless --frames
-    const double frame_dt_s = 1.0 / o.fps;
+/// The frame outputs of a run.
+struct PlayOutputs {
+    CreatedOutputs created;           ///< First member: outlives the video writer, whose file it may remove.
+    fs::path video_file;              ///< The video as the user will find it (or empty).
+    fs::path frame_folder;            ///< PNG frames (or empty).
+    std::string partial_video;        ///< The video while it is written.
+    bool video_named = false;         ///< --video was given: its errors say so.
     std::optional<VideoWriter> video;
-    // Video errors name the file the user knows, not the partial one being written.
-    const std::string partial_video = video_file.empty() ? std::string() : partial_path(video_file).string();
-    auto video_error = [&](std::string message) {
+
+    /// A video error naming the file the user knows, not the partial one being written.
+    [[nodiscard]] Error video_error(std::string message) const {
         if (const auto at = message.find(partial_video); !partial_video.empty() && at != std::string::npos)
             message.replace(at, partial_video.size(), video_file.string());
-        return report((o.video.empty() ? "" : "--video: ") + message);
-    };
-    if (!video_file.empty()) {
-        auto opened = VideoWriter::open(partial_video, size.first, size.second, o.fps);
-        if (!opened) return video_error(opened.error().message);
-        video.emplace(std::move(*opened));
+        return Error{(video_named ? "--video: " : "") + message};
     }
+};
 
-    const std::string what = !o.scene.empty() ? o.scene : !o.character.empty() ? o.character : "sample scene";
-    std::printf("drape play: %s, %zu character(s), %zu garment(s), %s\n", what.c_str(), world.characters.size(), world.garments.size(),
-                headless ? "headless" : window ? "window" : "off-screen");
+Result<void> open_outputs(PlayOutputs& out, const PlayOptions& o, const PlaySettings& s) {
+    out.video_file = o.video;
+    out.frame_folder = o.out;
+    out.video_named = !o.video.empty();
+    if (!s.headless && !s.window && o.video.empty() && o.out.empty()) {
+        const std::string stem = o.scene.empty() ? (o.character.empty() ? "sample" : fs::path(o.character).stem().string())
+                                                 : fs::path(o.scene).stem().string();
+        if (auto ok = out.created.create_folder("out"); !ok) return fail("out/: " + ok.error().message);
+        if (find_ffmpeg())
+            out.video_file = fresh_path("out", stem, ".mp4");
+        else
+            out.frame_folder = fresh_path("out", stem + "_frames", "");
+    }
+    if (!out.frame_folder.empty())
+        if (auto ok = out.created.create_folder(out.frame_folder); !ok) return fail("--out: " + ok.error().message);
+    out.partial_video = out.video_file.empty() ? std::string() : partial_path(out.video_file).string();
+    if (!out.video_file.empty()) {
+        auto opened = VideoWriter::open(out.partial_video, s.size.first, s.size.second, o.fps);
+        if (!opened) return std::unexpected(out.video_error(opened.error().message));
+        out.video.emplace(std::move(*opened));
+    }
+    return {};
+}
 
-    // --- The loop.
-    std::uint64_t dropped_frames = 0;
-    int played = 0;
+// ---------------------------------------------------------------------------------------
+// 6. The frames.
+
+/// What the loop did.
+struct PlayRun {
+    int played = 0;                   ///< Frames played.
+    std::uint64_t dropped_frames = 0; ///< Frames that dropped simulated time (hitches).
+    bool interrupted = false;         ///< Stopped by Ctrl-C.
+};
+
 #ifdef DRAPE_HAVE_RENDER
+/// The window's keys and the frame time they give: the wall-clock time since the last
+/// frame, none while paused, one fixed step for N.
+struct WindowControl {
     InputState input;
-    Image image;
     bool paused = false;
-    auto last = std::chrono::steady_clock::now();
+    std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+
+    /// False when the window was closed or Q pressed.
+    bool next_frame(World& world, double& dt) {
+        if (!world.renderer->poll_events(input) || input.has(Action::quit)) return false;
+        bool step_once = false;
+        for (Action a : input.actions) {
+            switch (a) {
+                case Action::toggle_pause: paused = !paused; break;
+                case Action::step: step_once = true; break;
+                case Action::toggle_ellipsoids: world.renderer->set_show_ellipsoids(!world.renderer->show_ellipsoids()); break;
+                case Action::switch_model: {
+                    const bool simplified = !world.scene.garments.empty() && world.scene.garments[0].model == ClothModel::simplified;
+                    set_garment_model(world, simplified ? ClothModel::classic : ClothModel::simplified);
+                    break;
+                }
+                case Action::reset: reset_garments(world); break;
+                case Action::quit: break;
+            }
+        }
+        const auto now = std::chrono::steady_clock::now();
+        dt = std::chrono::duration<double>(now - last).count();
+        last = now;
+        if (paused) dt = step_once ? world.scheduler.settings().fixed_dt_s / std::max(1e-9, world.scheduler.settings().time_scale) : 0.0;
+        return true;
+    }
+};
+
+/// Shows the frame in the window and writes it to the video and the frame folder.
+Result<void> show_and_record(World& world, PlayOutputs& out, bool window, int frame, Image& image) {
+    if (!world.renderer) return {};
+    if (window) {
+        if (auto ok = world.renderer->present(); !ok) return ok;
+    }
+    if (out.video || !out.frame_folder.empty()) {
+        if (auto ok = world.renderer->read_pixels(image); !ok) return ok;
+        if (out.video)
+            if (auto ok = out.video->write(image); !ok) return std::unexpected(out.video_error(ok.error().message));
+        if (!out.frame_folder.empty()) {
+            const fs::path file = out.frame_folder / frame_file_name(frame);
+            out.created.add_file(file);
+            if (auto ok = write_png(image, file); !ok) return ok;
+        }
+    }
+    return {};
+}
 #endif
-    g_interrupted = 0;
-    const auto previous_handler = std::signal(SIGINT, on_interrupt);
-    while ((frames == 0 || played < frames) && !g_interrupted) {
+
+/// Ctrl-C ends the loop between frames while this lives.
+class InterruptScope {
+public:
+    InterruptScope() : m_previous((g_interrupted = 0, std::signal(SIGINT, on_interrupt))) {}
+    InterruptScope(const InterruptScope&) = delete;
+    InterruptScope& operator=(const InterruptScope&) = delete;
+    ~InterruptScope() { std::signal(SIGINT, m_previous); }
+
+private:
+    void (*m_previous)(int);
+};
+
+Result<PlayRun> run_frames(World& world, const PlayOptions& o, const PlaySettings& s, PlayOutputs& out) {
+    const int frames = o.frames.value_or(s.window ? 0 : 240);  // window: until closed unless --frames
+    const double frame_dt_s = 1.0 / o.fps;
+    PlayRun run;
+#ifdef DRAPE_HAVE_RENDER
+    WindowControl control;
+    Image image;
+#endif
+    const InterruptScope interrupts;
+    while ((frames == 0 || run.played < frames) && !g_interrupted) {
         double dt = frame_dt_s;
 #ifdef DRAPE_HAVE_RENDER
-        if (window) {
-            if (!world.renderer->poll_events(input) || input.has(Action::quit)) break;
-            bool step_once = false;
-            for (Action a : input.actions) {
-                switch (a) {
-                    case Action::toggle_pause: paused = !paused; break;
-                    case Action::step: step_once = true; break;
-                    case Action::toggle_ellipsoids: world.renderer->set_show_ellipsoids(!world.renderer->show_ellipsoids()); break;
-                    case Action::switch_model: {
-                        const bool simplified = !world.scene.garments.empty() && world.scene.garments[0].model == ClothModel::simplified;
-                        set_garment_model(world, simplified ? ClothModel::classic : ClothModel::simplified);
-                        break;
-                    }
-                    case Action::reset: reset_garments(world); break;
-                    case Action::quit: break;
-                }
-            }
-            const auto now = std::chrono::steady_clock::now();
-            dt = std::chrono::duration<double>(now - last).count();
-            last = now;
-            if (paused) dt = step_once ? world.scheduler.settings().fixed_dt_s / std::max(1e-9, world.scheduler.settings().time_scale) : 0.0;
-        }
+        if (s.window && !control.next_frame(world, dt)) break;
 #endif
         auto ticked = step_world(world, dt);
-        if (!ticked) return report(ticked.error().message);
-        if (ticked->dropped_s > 0) ++dropped_frames;
-        ++played;
+        if (!ticked) return std::unexpected(ticked.error());
+        if (ticked->dropped_s > 0) ++run.dropped_frames;
+        ++run.played;
 #ifdef DRAPE_HAVE_RENDER
-        if (world.renderer) {
-            if (window) {
-                if (auto ok = world.renderer->present(); !ok) return report(ok.error().message);
-            }
-            if (video || !frame_folder.empty()) {
-                if (auto ok = world.renderer->read_pixels(image); !ok) return report(ok.error().message);
-                if (video)
-                    if (auto ok = video->write(image); !ok) return video_error(ok.error().message);
-                if (!frame_folder.empty()) {
-                    char name[32];
-                    std::snprintf(name, sizeof name, "frame_%05d.png", played - 1);
-                    created.add_file(frame_folder / name);
-                    if (auto ok = write_png(image, frame_folder / name); !ok) return report(ok.error().message);
-                }
-            }
-        }
+        if (auto ok = show_and_record(world, out, s.window, run.played - 1, image); !ok) return std::unexpected(ok.error());
+#else
+        (void)out;
 #endif
     }
-    std::signal(SIGINT, previous_handler);
-    if (video) {
-        if (auto ok = video->close(); !ok) return video_error(ok.error().message);
-        if (auto ok = commit_partial(video->file(), video_file); !ok) return report(ok.error().message);
-    }
-    // The folder now holds this run's frames only (older frames past the last one go).
-    if (!frame_folder.empty())
-        for (const fs::path& f : frame_files(frame_folder))
-            if (std::stoi(f.filename().string().substr(6, 5)) >= played) {
-                std::error_code ec;
-                fs::remove(f, ec);
-            }
-    created.keep();
-    if (g_interrupted) std::printf("drape play: interrupted after %d frames\n", played);
+    run.interrupted = g_interrupted != 0;
+    return run;
+}
 
-    // --- Reports.
+// ---------------------------------------------------------------------------------------
+// 7. Closing the outputs: the video gets its name, the frame folder holds this run's
+//    frames only (older frames past the last one go), and what the run made is kept.
+Result<void> close_outputs(PlayOutputs& out, int played) {
+    if (out.video) {
+        if (auto ok = out.video->close(); !ok) return std::unexpected(out.video_error(ok.error().message));
+        if (auto ok = commit_partial(out.video->file(), out.video_file); !ok) return ok;
+    }
+    if (!out.frame_folder.empty()) remove_frames_from(out.frame_folder, played);
+    out.created.keep();
+    return {};
+}
+
+// ---------------------------------------------------------------------------------------
+// 8. The frame budget and where the frames went.
+void print_budget(const World& world, const PlayRun& run, const PlayOutputs& out, const PlaySettings& s) {
     std::fputs(world.scheduler.profiler().table().c_str(), stdout);
-    std::printf("%d frames, %.2f s simulated", played, world.scheduler.time_s());
+    std::printf("%d frames, %.2f s simulated", run.played, world.scheduler.time_s());
     if (world.scheduler.total_dropped_s() > 0)
         std::printf(", %.3f s dropped in %llu hitch frame(s)", world.scheduler.total_dropped_s(),
-                    static_cast<unsigned long long>(dropped_frames));
+                    static_cast<unsigned long long>(run.dropped_frames));
     if (world.teleports->teleports > 0)
         std::printf(", %llu teleport(s)", static_cast<unsigned long long>(world.teleports->teleports));
     std::printf("\n");
-    if (video) std::printf("video: %s\n", video_file.c_str());
-    if (!frame_folder.empty() && !headless) std::printf("frames: %s/frame_%%05d.png\n", frame_folder.c_str());
+    if (out.video) std::printf("video: %s\n", out.video_file.c_str());
+    if (!out.frame_folder.empty() && !s.headless) std::printf("frames: %s/frame_%%05d.png\n", out.frame_folder.c_str());
+}
+
+// ---------------------------------------------------------------------------------------
+// 9. Reports: the trace and the stats, each through a partial file; then the run's own
+//    verdict. Each failure is reported; the exit status is 1 when any failed.
+
+/// Writes one report through a partial file; the error is prefixed with `option`.
+template <class Write>
+Result<void> write_report(const char* option, const fs::path& file, Write write) {
+    const fs::path partial = partial_path(file);
+    auto ok = write(partial);
+    if (ok) ok = commit_partial(partial, file);
+    if (!ok) {
+        std::error_code ec;
+        fs::remove(partial, ec);
+        return fail(std::string(option) + ": " + ok.error().message);
+    }
+    return {};
+}
+
+int write_reports(const World& world, const PlayOptions& o) {
     int status = 0;
-    if (!o.trace.empty()) {
-        const fs::path partial = partial_path(o.trace);
-        auto ok = world.scheduler.profiler().write_trace(partial);
-        if (ok) ok = commit_partial(partial, o.trace);
-        if (!ok) {
-            std::error_code ec;
-            fs::remove(partial, ec);
-            status = report("--trace: " + ok.error().message);
-        }
-    }
-    if (!o.stats.empty()) {
-        const fs::path partial = partial_path(o.stats);
-        auto ok = write_stats(run_stats(world), partial);
-        if (ok) ok = commit_partial(partial, o.stats);
-        if (!ok) {
-            std::error_code ec;
-            fs::remove(partial, ec);
-            status = report("--stats: " + ok.error().message);
-        }
-    }
+    if (!o.trace.empty())
+        if (auto ok = write_report("--trace", o.trace, [&](const fs::path& p) { return world.scheduler.profiler().write_trace(p); }); !ok)
+            status = report(ok.error().message);
+    if (!o.stats.empty())
+        if (auto ok = write_report("--stats", o.stats, [&](const fs::path& p) { return write_stats(run_stats(world), p); }); !ok)
+            status = report(ok.error().message);
     if (has_nonfinite(world)) status = report("the simulation produced non-finite values (see --stats FILE for which garment)");
     return status;
+}
+
+// ---------------------------------------------------------------------------------------
+int play(const PlayOptions& o) {
+    const auto settings = check_options(o);
+    if (!settings) return report(settings.error().message);
+    auto scene = load_scene(o);
+    if (!scene) return report(scene.error().message);
+    if (auto ok = apply_command_line(*scene, o); !ok) return report(ok.error().message);
+    auto world = build_play_world(*scene, o, *settings);
+    if (!world) return report(world.error().message);
+    PlayOutputs outputs;
+    if (auto ok = open_outputs(outputs, o, *settings); !ok) return report(ok.error().message);
+
+    const std::string what = !o.scene.empty() ? o.scene : !o.character.empty() ? o.character : "sample scene";
+    std::printf("drape play: %s, %zu character(s), %zu garment(s), %s\n", what.c_str(), world->characters.size(),
+                world->garments.size(), settings->headless ? "headless" : settings->window ? "window" : "off-screen");
+    const auto run = run_frames(*world, o, *settings, outputs);
+    if (!run) return report(run.error().message);
+    if (auto ok = close_outputs(outputs, run->played); !ok) return report(ok.error().message);
+    if (run->interrupted) std::printf("drape play: interrupted after %d frames\n", run->played);
+
+    print_budget(*world, *run, outputs, *settings);
+    return write_reports(*world, o);
 }
 
 }  // namespace

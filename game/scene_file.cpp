@@ -12,45 +12,19 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
 #include <nlohmann/json.hpp>
 
+#include "game/scene_garment_parameters.hpp"
+#include "systems/cloth/garment_parameters.hpp"
+
 namespace drape {
 
 using Json = nlohmann::json;
-
-std::string SourceLocation::str() const {
-    if (file.empty()) return {};
-    if (line <= 0) return file;
-    return file + ":" + std::to_string(line) + ":" + std::to_string(column);
-}
-
-std::string located(const SourceLocation& where, std::string_view field, std::string_view reason) {
-    std::string out = where.str();
-    if (!out.empty()) out += ": ";
-    if (!field.empty()) {
-        out += field;
-        out += ": ";
-    }
-    out += reason;
-    return out;
-}
-
-Quat CharacterDescription::rotation() const {
-    constexpr Real to_rad = Real(3.14159265358979323846 / 180.0);
-    return Quat(Eigen::AngleAxis<Real>(rotation_deg.y() * to_rad, Vec3::UnitY()) *
-                Eigen::AngleAxis<Real>(rotation_deg.x() * to_rad, Vec3::UnitX()) *
-                Eigen::AngleAxis<Real>(rotation_deg.z() * to_rad, Vec3::UnitZ()));
-}
-
-const char* garment_type_name(GarmentType t) noexcept { return t == GarmentType::skirt ? "skirt" : "dress"; }
-const char* cloth_model_name(ClothModel m) noexcept { return m == ClothModel::simplified ? "simplified" : "classic"; }
-const char* collision_mode_name(CollisionMode m) noexcept {
-    return m == CollisionMode::candidate_lists ? "lists" : "brute_force";
-}
 
 std::pair<int, int> line_column(std::string_view text, std::size_t offset) {
     offset = std::min(offset, text.size());
@@ -379,6 +353,28 @@ int read_int(const Reader& r, const std::string& path, const Json& j, long long 
     return static_cast<int>(j.get<long long>());
 }
 
+// A garment parameter against its spec (the same range validate(TubeParams) checks). A
+// real is also checked as the Real the builder will hold, so that nothing the file
+// passes is refused later for rounding (1e-50 is 0 as a float).
+double read_parameter(const Reader& r, const std::string& path, const Json& j, const ParameterSpec& spec) {
+    const std::string range = spec.range.text();
+    if (spec.kind == ParameterKind::integer) {
+        if (!j.is_number_integer()) {
+            const std::string what = j.is_number() ? "number" : j.type_name();
+            r.fail_at(path, cat("must be an integer in ", range, ", got ", what, " ", shown(j)));
+        }
+        const double v = j.get<double>();  // exact for any sane value; unsigned 64-bit giants stay out of range
+        if (!spec.range.contains(v)) r.fail_at(path, cat("must be an integer in ", range, ", got ", shown(j)));
+        return v;
+    }
+    if (!j.is_number()) r.fail_at(path, cat("must be a number in ", range, ", got ", typed(j)));
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) r.fail_at(path, cat("must be a finite number, got ", shown(j)));
+    const bool fits_real = std::abs(v) <= double(std::numeric_limits<Real>::max()) && spec.range.contains(double(static_cast<Real>(v)));
+    if (!spec.range.contains(v) || !fits_real) r.fail_at(path, cat("must be a number in ", range, ", got ", shown(j)));
+    return v;
+}
+
 bool read_bool(const Reader& r, const std::string& path, const Json& j) {
     if (!j.is_boolean()) r.fail_at(path, cat("must be true or false, got ", typed(j)));
     return j.get<bool>();
@@ -463,14 +459,23 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
         g.collision = read_choice<CollisionMode>(r, f.path("collision"), *v,
                                                  {{"lists", CollisionMode::candidate_lists}, {"brute_force", CollisionMode::brute_force}});
     if (const Json* v = f.get("color")) g.color = read_vec3(r, f.path("color"), *v, 0, 1);
-    for (const GarmentParameterSpec& spec : garment_parameters(g.type)) {
-        const Json* v = f.get(spec.name);
-        if (v == nullptr) continue;
-        const std::string p = f.path(spec.name);
-        const double value = spec.integer ? read_int(r, p, *v, static_cast<long long>(spec.min), static_cast<long long>(spec.max))
-                                          : read_real(r, p, *v, spec.min, spec.max, spec.min_exclusive ? Bound::open : Bound::closed);
-        g.parameters.push_back({std::string(spec.name), value});  // in table order
+    if (const Json* v = f.get("material")) {
+        std::string names;
+        for (const MaterialPreset& preset : material_presets()) names += cat(names.empty() ? "\"" : ", \"", preset.name, "\"");
+        if (!v->is_string() || !material_preset(v->get<std::string>()))
+            r.fail_at(f.path("material"), cat("must be one of ", names, ", got ", v->is_string() ? shown(*v) : typed(*v)));
+        g.material = v->get<std::string>();
     }
+    for (const ParameterSpec* spec : scene_garment_parameters()) {
+        const Json* v = f.get(spec->name);
+        if (v == nullptr) continue;
+        g.parameters.push_back({std::string(spec->name), read_parameter(r, f.path(spec->name), *v, *spec)});  // in table order
+    }
+    // Before a skirt and a dress shared one set of names, the ring height had one per type.
+    for (const auto& [former, now] : {std::pair{"waist_height_fraction", "ring_height_fraction"}, {"waist_height_m", "ring_height_m"},
+                                      {"shoulder_height_fraction", "ring_height_fraction"}, {"shoulder_height_m", "ring_height_m"}})
+        if (j.contains(former))
+            r.fail_at(f.path(former), cat("renamed ", now, " (the ring is the waist of a skirt, the shoulders of a dress)"), true);
     f.finish();
     // The grid size, however it was given.
     auto param = [&](std::string_view name) -> const GarmentParameter* {
@@ -578,37 +583,6 @@ OrderedJson vec(const Vec3& v) { return OrderedJson::array({v.x(), v.y(), v.z()}
 
 }  // namespace
 
-const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type) {
-    // Mirrors SkirtParams, DressParams and ClothMaterial (systems/cloth/garment_builder.hpp,
-    // components/garment.hpp). The builder checks the combinations (validate(SkirtParams)).
-    auto shared = [](std::string_view ring_fraction, std::string_view ring_height) {
-        return std::vector<GarmentParameterSpec>{
-            {"particles", 16, max_scene_particles, false, true, "target particle count; sets warp_lines and particles_per_line"},
-            {"warp_lines", 3, 10000, false, true, "lines around the body (a multiple of weft_stride)"},
-            {"particles_per_line", 2, 10000, false, true, "particles down each line"},
-            {"weft_stride", 1, 16, false, true, "every weft_stride-th line is integrated (method 3.2)"},
-            {"length_m", 0, 10, true, false, "from the ring to the hem along the cloth"},
-            {"flare_deg", 0, 80, false, false, "cone half-angle from vertical"},
-            {"ease_m", 0, 1, false, false, "gap between body outline and cloth"},
-            {ring_fraction, 0, 1, true, false, "ring height / body height"},
-            {ring_height, 0, 10, false, false, "> 0: ring height above the body's lowest point"},
-            {"torso_radius_fraction", 0, 1, true, false, "colliders farther from the axis (x height) are not outline"},
-            {"fitting_rows", 1, 1000, false, true, "rows pinned to the body (method 3.5)"},
-            {"mass_kg", 0, 100, true, false, "whole garment"},
-            {"stretch_k_N_m", 0, 1e7, true, false, "per stretch spring"},
-            {"shear_k_N_m", 0, 1e7, true, false, "classic model only"},
-            {"bend_k_N_m", 0, 1e7, true, false, "classic model only"},
-            {"drag_N_s_m", 0, 100, false, false, "air drag per particle (method 3.3 k)"},
-            {"strain_limit", 0, 10, true, false, "Provot: largest relative over-stretch (method 4.1)"},
-            {"strain_iterations", 0, 100, false, true, "Provot passes"},
-            {"candidate_margin_m", 0, 1, false, false, "candidate lists: reach beyond the surface (method 5)"},
-        };
-    };
-    static const std::vector<GarmentParameterSpec> skirt = shared("waist_height_fraction", "waist_height_m");
-    static const std::vector<GarmentParameterSpec> dress = shared("shoulder_height_fraction", "shoulder_height_m");
-    return type == GarmentType::skirt ? skirt : dress;
-}
-
 Result<SceneDescription> parse_scene(std::string_view text, std::string_view label, const std::filesystem::path& base_dir) {
     const std::string name(label);
     Json j;
@@ -698,10 +672,11 @@ std::string to_json(const SceneDescription& scene) {
         o["model"] = cloth_model_name(g.model);
         o["collision"] = collision_mode_name(g.collision);
         if (g.color) o["color"] = vec(*g.color);
+        if (!g.material.empty()) o["material"] = g.material;
         for (const GarmentParameter& p : g.parameters) {
-            const auto& specs = garment_parameters(g.type);
-            const auto spec = std::find_if(specs.begin(), specs.end(), [&](const GarmentParameterSpec& s) { return s.name == p.name; });
-            if (spec != specs.end() && spec->integer)
+            const auto specs = scene_garment_parameters();
+            const auto spec = std::find_if(specs.begin(), specs.end(), [&](const ParameterSpec* s) { return s->name == p.name; });
+            if (spec != specs.end() && (*spec)->kind == ParameterKind::integer)
                 o[p.name] = static_cast<long long>(std::llround(p.value));
             else
                 o[p.name] = p.value;

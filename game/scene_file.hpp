@@ -1,10 +1,5 @@
-// Scene descriptions and the JSON scene files they are read from (docs/scenes.md).
-//
-// A `SceneDescription` says what a world holds: characters (file, clip, placement,
-// playback), garments (type, parameters, colour, model, collision), collider overrides,
-// solver settings and a camera. `build_world` (game/scene.hpp) turns it into a running
-// Registry + Scheduler. The description is plain data: tests and benchmarks build one in
-// code, `drape play --scene` reads one from a file.
+// Scene files: the JSON files scene descriptions (game/scene_description.hpp) are read
+// from and written to (docs/scenes.md).
 //
 // Errors are one line naming the file, line and column and the field path, e.g.
 //   scene.json:7:21: garments[0].particles: must be an integer in [16, 250000], got -3
@@ -14,132 +9,16 @@
 // Relative paths resolve against the scene file's folder.
 #pragma once
 
-#include <cstdint>
 #include <filesystem>
-#include <optional>
 #include <string>
 #include <string_view>
-#include <vector>
+#include <utility>
 
-#include "components/garment.hpp"
 #include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
+#include "game/scene_description.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
-
-/// Where a value of a description came from, for error messages. Empty for descriptions
-/// built in code.
-struct SourceLocation {
-    std::string file;   ///< As the user named it.
-    int line = 0;       ///< 1-based; 0 = unknown.
-    int column = 0;     ///< 1-based, in bytes.
-
-    /// "file:line:column" (or "file", or "" when nothing is known).
-    [[nodiscard]] std::string str() const;
-    friend bool operator==(const SourceLocation&, const SourceLocation&) = default;
-};
-
-/// "where: field: reason", leaving out the empty parts.
-[[nodiscard]] std::string located(const SourceLocation& where, std::string_view field, std::string_view reason);
-
-/// A character to load and place.
-struct CharacterDescription {
-    std::filesystem::path file;          ///< .glb/.gltf/.fbx/...; resolved against the scene folder.
-    std::string clip;                    ///< Clip name, or its index as digits; empty: the importer's choice (a walk when there is one).
-    Real scale = 1;                      ///< Uniform factor on top of the importer's unit normalisation.
-    Vec3 position_m = Vec3::Zero();      ///< World placement of the character's origin.
-    Vec3 rotation_deg = Vec3::Zero();    ///< Euler angles, applied as yaw (Y) * pitch (X) * roll (Z).
-    double speed = 1;                    ///< Playback rate of the clip.
-    bool in_place = true;                ///< true: the walk stays in place; false: root motion moves the character.
-    SourceLocation where;                ///< Of the "file" field, for load errors.
-
-    [[nodiscard]] Quat rotation() const;
-    friend bool operator==(const CharacterDescription&, const CharacterDescription&) = default;
-};
-
-enum class GarmentType : std::uint8_t { skirt, dress };
-[[nodiscard]] const char* garment_type_name(GarmentType t) noexcept;
-[[nodiscard]] const char* cloth_model_name(ClothModel m) noexcept;
-[[nodiscard]] const char* collision_mode_name(CollisionMode m) noexcept;
-
-/// One numeric garment parameter set in a scene (the name is a field of SkirtParams or
-/// DressParams; see garment_parameters()).
-struct GarmentParameter {
-    std::string name;
-    double value = 0;
-    friend bool operator==(const GarmentParameter&, const GarmentParameter&) = default;
-};
-
-/// A garment worn by one of the scene's characters.
-struct GarmentDescription {
-    GarmentType type = GarmentType::skirt;
-    int character = 0;                                   ///< Index into SceneDescription::characters.
-    ClothModel model = ClothModel::simplified;
-    CollisionMode collision = CollisionMode::candidate_lists;
-    std::optional<Vec3> color;                           ///< Linear RGB in [0, 1]; none: the garment's default.
-    std::vector<GarmentParameter> parameters;            ///< Overrides of the builder's defaults, in file order.
-    SourceLocation where;                                ///< Of the garment object, for build errors.
-    friend bool operator==(const GarmentDescription&, const GarmentDescription&) = default;
-};
-
-/// Replaces (or adds) the ellipsoid bound to one bone after the colliders were fitted.
-struct ColliderOverride {
-    int character = 0;
-    std::string bone;                                    ///< Bone name as in the character file.
-    bool remove = false;                                 ///< Drop the fitted ellipsoid(s) of this bone instead.
-    std::optional<Vec3> center_m;                        ///< Bone space.
-    std::optional<Vec3> radii_m;
-    std::optional<Vec3> rotation_deg;                    ///< Bone space, yaw * pitch * roll.
-    SourceLocation where;
-    friend bool operator==(const ColliderOverride&, const ColliderOverride&) = default;
-};
-
-/// Stepping and robustness settings (see engine/core/scheduler.hpp for the stepping).
-struct SolverDescription {
-    double fixed_dt_s = 1.0 / 60.0;      ///< Simulated time per fixed step.
-    int max_steps_per_frame = 4;         ///< Time beyond this many steps per frame is dropped.
-    double time_scale = 1;               ///< Simulated seconds per wall-clock second.
-    int substeps = 0;                    ///< Simulation substeps per step; 0 = the cloth's stability rule.
-    double max_frame_dt_s = 0.25;        ///< Longer frames (hitches) are clamped to this first.
-    double teleport_threshold_m = 1.0;   ///< A body moving further in one step resets its garments.
-    int threads = 0;                     ///< Worker threads; 0 = all cores.
-    friend bool operator==(const SolverDescription&, const SolverDescription&) = default;
-};
-
-/// Camera: an orbit around a target (engine/render/camera.hpp).
-struct CameraDescription {
-    bool follow = true;                  ///< Keep the target on the first character.
-    Vec3 target_m = Vec3(0, 1, 0);       ///< Look-at point (the start point when following).
-    Real distance_m = 3.5f;
-    Real yaw_deg = 34;                   ///< Around Y; 0 = the camera on +Z of the target.
-    Real pitch_deg = 14;                 ///< Above the horizon.
-    Real fov_deg = 40;                   ///< Vertical field of view.
-    friend bool operator==(const CameraDescription&, const CameraDescription&) = default;
-};
-
-struct SceneDescription {
-    std::string description;             ///< Free text (JSON has no comments).
-    std::vector<CharacterDescription> characters;
-    std::vector<GarmentDescription> garments;
-    std::vector<ColliderOverride> colliders;
-    SolverDescription solver;
-    CameraDescription camera;
-    friend bool operator==(const SceneDescription&, const SceneDescription&) = default;
-};
-
-/// A numeric garment parameter a scene may set: its name, range and meaning.
-struct GarmentParameterSpec {
-    std::string_view name;               ///< A field of SkirtParams / DressParams / ClothMaterial, or "particles".
-    double min, max;                     ///< Range; max inclusive.
-    bool min_exclusive;                  ///< true: (min, max]; false: [min, max].
-    bool integer;
-    std::string_view doc;
-};
-
-/// The parameters a garment type accepts in a scene file (docs/scenes.md lists them).
-/// "particles" is a target count that chooses warp_lines and particles_per_line.
-[[nodiscard]] const std::vector<GarmentParameterSpec>& garment_parameters(GarmentType type);
 
 /// Upper bound on particles per garment accepted from a scene: the garment builders' own.
 inline constexpr int max_scene_particles = max_garment_particles;

@@ -12,33 +12,43 @@ namespace drape {
 GarmentWatch::GarmentWatch(const Registry& registry, std::vector<Entity> garments) {
     for (Entity e : garments) {
         const Garment* g = registry.try_get<Garment>(e);
-        m_tracks.push_back(Track{.entity = e, .tests_at_start = g ? g->counters.collision_tests : 0});
+        Track t;
+        t.entity = e;
+        t.tests_at_start = g ? g->counters.collision_tests : 0;
+        t.resets_at_start = g ? g->counters.resets : 0;
+        m_tracks.push_back(std::move(t));
     }
 }
 
 void GarmentWatch::sample(const Registry& registry) {
     ++m_frames;
+    // The worst so far; a NaN stays (it is written as null: a bug to report).
+    auto worse = [](double& worst, double value) {
+        if (!std::isnan(worst) && (std::isnan(value) || value > worst)) worst = value;
+    };
     for (Track& t : m_tracks) {
         const Garment* g = registry.try_get<Garment>(t.entity);
         if (g == nullptr) continue;
-        const GarmentCounters& c = g->counters;
-        if (std::isfinite(c.max_strain)) t.max_strain = std::max(t.max_strain, double(c.max_strain));
-        if (std::isfinite(c.max_penetration_m)) t.max_penetration_m = std::max(t.max_penetration_m, double(c.max_penetration_m));
-        for (Eigen::Index i = 0; i < g->state.x.cols(); ++i)
-            if (!g->state.x.col(i).allFinite() || (i < g->state.v.cols() && !g->state.v.col(i).allFinite())) ++t.nonfinite_seen;
+        const GarmentQuality q = measure_garment(registry, *g, t.strains.get());
+        GarmentStats& w = t.worst;
+        worse(w.strain_max, q.strain_max);
+        worse(w.penetration_after_frame_m, q.penetration_m);
+        worse(w.pins_inside_m, q.pins_inside_m);
+        worse(w.rise_above_pins_m, q.rise_above_pins_m);
+        worse(w.penetration_before_response_m, g->counters.max_penetration_m);
+        w.nonfinite += q.nonfinite;
     }
 }
 
 std::vector<GarmentStats> GarmentWatch::result(const Registry& registry) const {
     std::vector<GarmentStats> out;
     for (const Track& t : m_tracks) {
-        GarmentStats s;
-        s.max_strain = t.max_strain;
-        s.max_penetration_m = t.max_penetration_m;
-        s.nonfinite = t.nonfinite_seen;
+        GarmentStats s = t.worst;
+        s.strain_p99 = t.strains->percentile(0.99);
         if (const Garment* g = registry.try_get<Garment>(t.entity)) {
             s.particles = static_cast<std::uint64_t>(g->state.x.cols());
             s.nonfinite += g->counters.non_finite_values;
+            s.resets = g->counters.resets - t.resets_at_start;
             if (m_frames > 0)
                 s.collision_tests_per_frame = double(g->counters.collision_tests - t.tests_at_start) / double(m_frames);
         }
@@ -68,15 +78,25 @@ std::string stats_json(const RunStats& stats) {
                            {"p50_ms", number(s.p50_ms)},
                            {"p95_ms", number(s.p95_ms)},
                            {"max_ms", number(s.max_ms)}};
+    Json characters = Json::array();
+    for (const CharacterStats& c : stats.characters)
+        characters.push_back({{"file", c.file}, {"clip", c.clip}, {"height_m", number(c.height_m)}});
     Json garments = Json::array();
     for (const GarmentStats& g : stats.garments)
         garments.push_back({{"particles", g.particles},
-                            {"max_strain", number(g.max_strain)},
-                            {"max_penetration_m", number(g.max_penetration_m)},
+                            {"strain", {{"max", number(g.strain_max)}, {"p99", number(g.strain_p99)}}},
+                            {"penetration_m",
+                             {{"after_frame_max", number(g.penetration_after_frame_m)},
+                              {"before_response_max", number(g.penetration_before_response_m)}}},
+                            {"pins_inside_m", number(g.pins_inside_m)},
+                            {"rise_above_pins_m", number(g.rise_above_pins_m)},
                             {"nonfinite", g.nonfinite},
-                            {"collision_tests_per_frame", number(g.collision_tests_per_frame)}});
-    Json j = {{"frames", stats.frames}, {"sim_dt_s", number(stats.sim_dt_s)}, {"systems", std::move(systems)},
-              {"garments", std::move(garments)}};
+                            {"resets", g.resets},
+                            {"collision_tests_per_frame", number(g.collision_tests_per_frame)},
+                            {"max_strain", number(g.strain_max)},
+                            {"max_penetration_m", number(g.penetration_before_response_m)}});
+    Json j = {{"frames", stats.frames},          {"sim_dt_s", number(stats.sim_dt_s)}, {"characters", std::move(characters)},
+              {"systems", std::move(systems)},   {"garments", std::move(garments)}};
     return j.dump(2) + "\n";
 }
 

@@ -1,38 +1,58 @@
 // The run statistics `drape play --stats FILE.json` writes (docs/scenes.md, "Stats file"):
 //
 //   {"frames": N, "sim_dt_s": S,
+//    "characters": [{"file", "clip", "height_m"}],
 //    "systems": {NAME: {"runs", "skips", "mean_ms", "p50_ms", "p95_ms", "max_ms"}},
-//    "garments": [{"particles", "max_strain", "max_penetration_m", "nonfinite",
-//                  "collision_tests_per_frame"}]}
+//    "garments": [{"particles",
+//                  "strain": {"max", "p99"},
+//                  "penetration_m": {"after_frame_max", "before_response_max"},
+//                  "pins_inside_m", "rise_above_pins_m", "nonfinite", "resets",
+//                  "collision_tests_per_frame", "max_strain", "max_penetration_m"}]}
 //
-// `sim_dt_s` is the fixed simulation step. Garment figures are the worst seen over the
-// run: `GarmentWatch::sample` reads each garment's counters (components/garment.hpp)
-// after every frame and also scans its particles for non-finite values itself.
+// `sim_dt_s` is the fixed simulation step. Garment figures are measured after every whole
+// frame (systems/cloth/garment_quality.hpp) and are the worst seen over the run, except
+// `strain.p99`: the 99th percentile over every spring of every frame. `max_strain` and
+// `max_penetration_m` repeat `strain.max` and `penetration_m.before_response_max`.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "engine/core/error.hpp"
 #include "engine/core/profiler.hpp"
 #include "engine/core/registry.hpp"
+#include "systems/cloth/garment_quality.hpp"
 
 namespace drape {
 
 /// One garment over a run.
 struct GarmentStats {
     std::uint64_t particles = 0;
-    double max_strain = 0;               ///< Largest spring length / rest - 1 seen.
-    double max_penetration_m = 0;        ///< Deepest particle penetration into an ellipsoid seen (before response).
+    double strain_max = 0;               ///< Largest strain of a structural spring with a free end after a frame.
+    double strain_p99 = 0;               ///< 99th percentile of those strains over every frame.
+    double penetration_after_frame_m = 0;///< Deepest free particle inside an ellipsoid after a frame.
+    double penetration_before_response_m = 0; ///< Deepest penetration the collision found before moving a particle out.
+    double pins_inside_m = 0;            ///< Deepest pinned particle inside an ellipsoid after a frame.
+    double rise_above_pins_m = 0;        ///< Highest free particle above the highest pin after a frame.
     std::uint64_t nonfinite = 0;         ///< Non-finite values the cloth found and reset, plus any left in x or v.
+    std::uint64_t resets = 0;            ///< Garment resets during the run (non-finite state, teleports, requests).
     double collision_tests_per_frame = 0;///< Particle-ellipsoid tests per rendered frame, mean.
+};
+
+/// A character of the run: its file, the clip it plays, its height.
+struct CharacterStats {
+    std::string file;
+    std::string clip;
+    double height_m = 0;
 };
 
 struct RunStats {
     std::uint64_t frames = 0;
     double sim_dt_s = 0;
+    std::vector<CharacterStats> characters;  ///< In scene order.
     std::vector<SystemStats> systems;    ///< In scheduler order.
     std::vector<GarmentStats> garments;  ///< In scene order.
 };
@@ -52,9 +72,9 @@ public:
 private:
     struct Track {
         Entity entity;
-        double max_strain = 0, max_penetration_m = 0;
-        std::uint64_t nonfinite_seen = 0;    ///< Particles found non-finite by sample().
-        std::uint64_t tests_at_start = 0;
+        GarmentStats worst;
+        std::shared_ptr<StrainHistogram> strains = std::make_shared<StrainHistogram>();
+        std::uint64_t tests_at_start = 0, resets_at_start = 0;
     };
     std::vector<Track> m_tracks;
     std::uint64_t m_frames = 0;

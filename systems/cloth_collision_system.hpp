@@ -1,7 +1,8 @@
-// Cloth collision system (method §5): every garment against the ellipsoids of its body at
-// the end of the substep, with candidate lists and temporal coherence, then the
-// non-finite check. Last of the three cloth systems in every substep, timed as
-// "cloth_collision".
+// Cloth collision system (method §5): every garment against the ellipsoids of its body,
+// with candidate lists and temporal coherence. In each of the constraint system's rounds the
+// integrated particles (and, in the simplified model, the chords layer 2 is placed on) are
+// moved out, positions only; after the rounds, the simplified model's layer 2, then the
+// non-finite check. Timed as "cloth_collision".
 #pragma once
 
 #include "engine/core/registry.hpp"
@@ -10,7 +11,13 @@
 
 namespace drape {
 
-/// One substep of every garment of `batch`, in parallel over garments.
-void run_cloth_collision(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep);
+/// Colliders and candidate lists of every garment for the substep, in parallel.
+void run_cloth_collision_prepare(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep);
+
+/// Round `round` of every garment of `batch` that takes that many rounds, in parallel.
+void run_cloth_collision_round(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep, int round);
+
+/// After the rounds, every garment, in parallel.
+void run_cloth_collision_finish(const Registry& registry, const GarmentBatch& batch, const ClothSubstep& substep);
 
 }  // namespace drape

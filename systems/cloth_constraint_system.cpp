@@ -3,11 +3,14 @@
 
 namespace drape {
 
-void run_cloth_constraint(const GarmentBatch& batch, const ClothSubstep& substep) {
+void run_cloth_constraint_round(const GarmentBatch& batch, const ClothSubstep& substep, int round) {
     batch.for_each([&](Garment& g, GarmentSolver& s) {
-        constrain_garment(g, s, substep);
-        if (substep.last()) record_strain(g);
+        if (round < constraint_rounds(g)) constrain_round(g, s, substep, round);
     });
+}
+
+void run_cloth_constraint_finish(const GarmentBatch& batch, const ClothSubstep& substep) {
+    batch.for_each([&](Garment& g, GarmentSolver& s) { finish_constraints(g, s, substep); });
 }
 
 }  // namespace drape

@@ -1,7 +1,7 @@
-// Cloth constraint system (method §4): Provot's strain limit on the warp (§4.1); in the
-// simplified model the weft (layer 2) placed from layer 1 (§4.2); in the classic model
-// Provot on warp and weft. Second of the three cloth systems in every substep, timed as
-// "cloth_constraint".
+// Cloth constraint system (method §4): Gauss-Seidel rounds of tethers, springs in
+// compliance form and Provot's strain limit (§4.1), alternating with the collision system's
+// rounds; then the substep's velocities and, in the simplified model, the weft (layer 2)
+// placed from layer 1 (§4.2). Timed as "cloth_constraint".
 #pragma once
 
 #include "systems/cloth/garment_batch.hpp"
@@ -9,8 +9,10 @@
 
 namespace drape {
 
-/// One substep of every garment of `batch`, in parallel over garments. After the last
-/// substep's constraints it records each garment's largest strain.
-void run_cloth_constraint(const GarmentBatch& batch, const ClothSubstep& substep);
+/// Round `round` of every garment of `batch` that takes that many rounds, in parallel.
+void run_cloth_constraint_round(const GarmentBatch& batch, const ClothSubstep& substep, int round);
+
+/// After the rounds: velocities and the weft of every garment, in parallel.
+void run_cloth_constraint_finish(const GarmentBatch& batch, const ClothSubstep& substep);
 
 }  // namespace drape

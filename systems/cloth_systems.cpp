@@ -38,11 +38,18 @@ void run_step(Registry& registry, GarmentBatch& batch, double fixed_dt_s, const 
         if (profiler != nullptr && slots.timed) scope.emplace(*profiler, slots.slot[static_cast<std::size_t>(k)]);
         run();
     };
+    int rounds = 1;
+    for (const GarmentWork& w : batch.items) rounds = std::max(rounds, constraint_rounds(*w.garment));
     for (int i = 0; i < substeps; ++i) {
         const ClothSubstep sub = make_substep(i, substeps, fixed_dt_s);
         timed(0, [&] { run_cloth_integration(registry, batch, sub); });
-        timed(1, [&] { run_cloth_constraint(batch, sub); });
-        timed(2, [&] { run_cloth_collision(registry, batch, sub); });
+        timed(2, [&] { run_cloth_collision_prepare(registry, batch, sub); });
+        for (int round = 0; round < rounds; ++round) {
+            timed(1, [&] { run_cloth_constraint_round(batch, sub, round); });
+            timed(2, [&] { run_cloth_collision_round(registry, batch, sub, round); });
+        }
+        timed(1, [&] { run_cloth_constraint_finish(batch, sub); });
+        timed(2, [&] { run_cloth_collision_finish(registry, batch, sub); });
     }
 }
 

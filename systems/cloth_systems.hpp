@@ -3,10 +3,12 @@
 // Each fixed step it gathers the garments (creating a solver for a garment that has none),
 // takes the substeps of the rule in systems/cloth/substeps.hpp (the largest need of all
 // garments, or ClothSolverSettings::fixed_substeps), and runs, in every substep, the three
-// cloth systems in their order:
+// cloth systems in the order of systems/cloth/garment_step.hpp:
 //   cloth_integration  (cloth_integration_system.hpp)  method §3.3-§3.5
+//   then rounds of
 //   cloth_constraint   (cloth_constraint_system.hpp)   method §4
 //   cloth_collision    (cloth_collision_system.hpp)    method §5
+//   and each of the last two once more to finish the substep.
 // The scheduler times the whole step as "cloth"; each system is timed in a profiler slot of
 // its own under it, so the frame budget lists all four.
 #pragma once

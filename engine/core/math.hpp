@@ -29,6 +29,7 @@ using Matrix3X = Eigen::Matrix<Real, 3, Eigen::Dynamic>;  ///< One column per po
 /// One contiguous row per coordinate (structure of arrays): whole-row vector arithmetic.
 using Matrix3XRows = Eigen::Matrix<Real, 3, Eigen::Dynamic, Eigen::RowMajor>;
 using Matrix4X = Eigen::Matrix<Real, 4, Eigen::Dynamic>;
+using Matrix2X = Eigen::Matrix<Real, 2, Eigen::Dynamic>;
 using VectorX = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 using Vec4i = Eigen::Matrix<int, 4, 1>;
 

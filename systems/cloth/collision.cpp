@@ -463,15 +463,15 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
 
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
-                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected,
-                                  const Matrix3X* x_start, Real h, std::span<const Real> list_slack) {
+                                  std::vector<std::uint64_t>& last_collided, DetectedPairs* detected, Real friction,
+                                  std::span<const Real> list_slack, Eigen::Index first, Eigen::Index last_particle,
+                                  bool respond_velocity) {
     CollisionResult r;
     const Eigen::Index n = x.cols();
+    const Eigen::Index end = last_particle < 0 ? n : std::min(last_particle, n);
     last_collided.resize(static_cast<std::size_t>(n), 0);
     if (detected) detected->assign(static_cast<std::size_t>(n), 0);
     const std::uint64_t active = active_mask(frames);
-    const bool whole_move = x_start != nullptr && h > 0;
-    const Real inv_h = whole_move ? 1 / h : 0;
     std::array<Real, 64> outside{};  // per ellipsoid: 1 + surface_clearance, once per pass
     for_each_bit(active, [&](int e) { outside[static_cast<std::size_t>(e)] = 1 + surface_clearance(frames[static_cast<std::size_t>(e)]); });
 
@@ -504,7 +504,6 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             const Real depth = centre_line_depth(f, d, y_len, inv_len);
             if (responses == 0 && e == first) r.max_penetration_m = std::max(r.max_penetration_m, depth);
             last_y_surface = place_shortest(f, y, y_sq, inv_len, depth, xp, outside[static_cast<std::size_t>(e)]);
-            if (!whole_move) remove_approach(f, last_y_surface, xp, vp);  // else from the whole move, below
             last_e = e;
             ++responses;
             ++r.collisions;
@@ -534,8 +533,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                 // Still between overlapping ellipsoids (a crease, the thighs where they meet):
                 // leave from where it was detected by the shortest of a few straight ways out,
                 // past every ellipsoid the way crosses (fallback_exit).
-                xp = fallback_exit(frames, active, x_detected, hits, xp,
-                                   x_start != nullptr ? Vec3(x_start->col(p)) : x_detected);
+                xp = fallback_exit(frames, active, x_detected, hits, xp, x_detected);
                 fell_back = true;
                 Real depth = 0;
                 for_each_bit(active, [&](int e) {
@@ -545,18 +543,23 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                 if (depth > Real(1e-5)) ++r.unresolved;
             }
         }
-        if (whole_move) {
-            // Velocity of the whole move, then no normal velocity relative to any surface touched.
-            // A single push-out (the common case) left xp where last_y_surface maps.
-            vp = (xp - x_start->col(p)) * inv_h;
-            const bool single = responses == 1 && !fell_back;
-            for_each_bit(last_collided[pi], [&](int e) {
-                const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
-                const Vec3 normal = surface_normal(f, single && e == last_e ? last_y_surface : to_unit_sphere(f, xp));
-                const Vec3 surface_velocity = body_velocity_at(f, xp);
-                vp -= (vp - surface_velocity).dot(normal) * normal;
-            });
-        }
+        // Velocity: the push itself is not motion. What the particle had before it (its
+        // move up to the contact) keeps its part along each surface touched only where it
+        // does not approach that surface's own motion; Coulomb friction slows the tangential
+        // part by friction x the approach removed.
+        const bool single = responses == 1 && !fell_back;
+        if (respond_velocity) for_each_bit(last_collided[pi], [&](int e) {
+            const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+            const Vec3 normal = surface_normal(f, single && e == last_e ? last_y_surface : to_unit_sphere(f, xp));
+            const Vec3 surface_velocity = body_velocity_at(f, xp);
+            const Vec3 relative = vp - surface_velocity;
+            const Real approach = relative.dot(normal);
+            if (approach >= 0) return;
+            Vec3 tangential = relative - approach * normal;
+            const Real t_len = tangential.norm();
+            if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * approach / t_len);  // approach < 0
+            vp = surface_velocity + tangential;
+        });
         x.col(p) = xp;
         v.col(p) = vp;
     };
@@ -564,8 +567,8 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
     if (candidates) {
         // List mode: 64 particles at a time against the ellipsoids of their lists (detect_block).
         LaneBits block_lists{}, block_hits{};
-        for (Eigen::Index begin = 0; begin < n; begin += detect_lanes) {
-            const Eigen::Index count = std::min(detect_lanes, n - begin);
+        for (Eigen::Index begin = first; begin < end; begin += detect_lanes) {
+            const Eigen::Index count = std::min(detect_lanes, end - begin);
             const std::size_t bi = static_cast<std::size_t>(begin);
             block_lists.fill(0);
             std::uint64_t any = 0;
@@ -593,7 +596,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         }
     } else {
         // Brute force: every particle against every ellipsoid.
-        for (Eigen::Index p = 0; p < n; ++p) {
+        for (Eigen::Index p = first; p < end; ++p) {
             std::uint64_t hits = 0;
             if (inv_mass[p] != 0) {
                 const Vec3 xp = x.col(p);
@@ -741,7 +744,8 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
     alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
     // The particles without slack, gathered without a branch per particle; pinned ones are
     // never tested (method §3.5).
-    std::vector<Eigen::Index> spent(static_cast<std::size_t>(n));
+    std::vector<Eigen::Index>& spent = lists.spent;
+    spent.resize(static_cast<std::size_t>(n));
     std::size_t spent_count = 0;
     for (Eigen::Index begin = 0; begin < n; begin += 16) {
         const Eigen::Index end = std::min<Eigen::Index>(begin + 16, n);
@@ -772,25 +776,29 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
     g.counters.frame_list_rebuild_tests += tests;
 }
 
-CollisionResult collide_garment(Garment& g, GarmentSolver& solver, DetectedPairs* detected, Real h) {
-    const Eigen::Index n = g.state.x.cols();
+CollisionResult collide_range(Garment& g, GarmentSolver& solver, Eigen::Index first, Eigen::Index end, DetectedPairs* detected,
+                              bool respond_velocity) {
     const std::vector<std::uint64_t>* lists = nullptr;
     std::span<const Real> slack;
     if (g.config.collision == CollisionMode::candidate_lists) {
-        update_candidate_lists(g, solver);
+        if (!solver.lists.valid) update_candidate_lists(g, solver);
         lists = &solver.lists.bits;
         slack = std::span<const Real>(solver.lists.slack_m.data(), static_cast<std::size_t>(solver.lists.slack_m.size()));
     }
-    const bool have_start = h > 0 && solver.x_start.cols() == n;
     const CollisionResult r = collide_particles(g.state.x, g.state.v, g.state.inv_mass, solver.frames, lists,
-                                                solver.last_collided, detected, have_start ? &solver.x_start : nullptr, h,
-                                                slack);
+                                                solver.last_collided, detected, g.config.material.friction, slack, first, end,
+                                                respond_velocity);
     g.counters.frame_collision_tests += r.tests;
     g.counters.collision_tests += r.tests;
     g.counters.frame_collisions += r.collisions;
     g.counters.collisions += r.collisions;
     g.counters.max_penetration_m = std::max(g.counters.max_penetration_m, r.max_penetration_m);
     return r;
+}
+
+CollisionResult collide_garment(Garment& g, GarmentSolver& solver, DetectedPairs* detected) {
+    if (g.config.collision == CollisionMode::candidate_lists) update_candidate_lists(g, solver);
+    return collide_range(g, solver, 0, g.state.x.cols(), detected);
 }
 
 }  // namespace drape

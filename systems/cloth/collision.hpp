@@ -90,25 +90,31 @@ struct CollisionResult {
 /// found to contain it at the start of the pass, before any response.
 using DetectedPairs = std::vector<std::uint64_t>;
 
-/// Steps 2-3 for particles [0, cols). `candidates` null = brute force. `last_collided`
-/// is read (tested first) and rewritten. With `x_start` (positions at the start of the
-/// substep of length h_s), a colliding particle's velocity is recomputed from its move.
+/// Steps 2-3 for particles [first, end) (end < 0: all). `candidates` null = brute force.
+/// `last_collided` is read (tested first) and rewritten. A colliding particle keeps the
+/// velocity it had before the push-out, less its approach toward each surface it touched
+/// (relative to the surface's motion), its tangential part slowed by Coulomb `friction`.
 /// `list_slack_m` (per particle; empty = unlimited): how far a particle may still move
 /// before its list could miss an ellipsoid; a particle pushed farther is re-tested against
-/// every ellipsoid.
+/// every ellipsoid. `respond_velocity` false: positions only.
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr,
-                                  const Matrix3X* x_start = nullptr, Real h_s = 0,
-                                  std::span<const Real> list_slack_m = {});
+                                  Real friction = 0, std::span<const Real> list_slack_m = {}, Eigen::Index first = 0,
+                                  Eigen::Index end = -1, bool respond_velocity = true);
 
 /// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
 [[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,
                                                std::span<const EllipsoidFrame> frames);
 
-/// Whole garment: brings the lists up to date (update_candidate_lists) in list mode, then
-/// collides in the garment's mode and adds to its counters. The solver's frames must be
-/// current. h_s > 0: velocities of colliding particles from their move since `solver.x_start`.
-CollisionResult collide_garment(Garment& garment, GarmentSolver& solver, DetectedPairs* detected = nullptr, Real h_s = 0);
+/// Steps 2-3 for a garment's particles [first, end) in its collision mode against the
+/// solver's frames (which must be current), with its material's friction; in list mode the
+/// lists must be up to date (update_candidate_lists) or are brought up to date. Adds to the
+/// garment's counters.
+CollisionResult collide_range(Garment& garment, GarmentSolver& solver, Eigen::Index first, Eigen::Index end,
+                              DetectedPairs* detected = nullptr, bool respond_velocity = true);
+
+/// Whole garment: update_candidate_lists in list mode, then collide_range over every particle.
+CollisionResult collide_garment(Garment& garment, GarmentSolver& solver, DetectedPairs* detected = nullptr);
 
 }  // namespace drape

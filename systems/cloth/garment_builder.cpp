@@ -14,6 +14,7 @@
 #include "components/transform.hpp"
 #include "systems/cloth/body.hpp"
 #include "systems/cloth/collision.hpp"
+#include "systems/cloth/garment_parameters.hpp"
 #include "systems/cloth/garment_step.hpp"
 #include "systems/cloth/pins.hpp"
 
@@ -30,9 +31,9 @@ std::string number(Real v) {
     s << v;
     return s.str();
 }
-// In (0, hi] (or [0, hi] when zero is allowed), finite. The upper bounds are those of the
-// scene files' garment parameters (game/scene_file.cpp): beyond them float arithmetic, not
-// the cloth, decides what happens.
+// In (0, hi] (or [0, hi] when zero is allowed), finite: a rectangle's sizes. (The skirt's
+// and the dress's ranges are in the garment parameter table.) Beyond them float arithmetic,
+// not the cloth, decides what happens.
 bool in_range(Real v, Real hi, bool zero_allowed = false) {
     return std::isfinite(v) && (zero_allowed ? v >= 0 : v > 0) && v <= hi;
 }
@@ -57,25 +58,14 @@ Result<void> validate_grid(std::string_view p, int lines, int per_line, int stri
     return {};
 }
 
-Result<void> validate_tube(std::string_view p, int lines, int per_line, int stride, Real length, Real flare_deg,
-                           Real ease, Real height_fraction, std::string_view height_fraction_name, Real height_m,
-                           std::string_view height_m_name, Real torso_fraction, int fitting_rows,
-                           const ClothMaterial& material) {
-    if (auto ok = validate_grid(p, lines, per_line, stride, true); !ok) return ok;
-    if (!in_range(length, 10)) return fail(field(p, "length_m") + ": must be in (0, 10] m, got " + number(length));
-    if (!std::isfinite(flare_deg) || flare_deg < 0 || flare_deg > 80)
-        return fail(field(p, "flare_deg") + ": must be in [0, 80], got " + number(flare_deg));
-    if (!std::isfinite(ease) || ease < 0 || ease > 1)
-        return fail(field(p, "ease_m") + ": must be in [0, 1], got " + number(ease));
-    if (!std::isfinite(height_fraction) || height_fraction <= 0 || height_fraction >= 1)
-        return fail(field(p, height_fraction_name) + ": must be in (0, 1), got " + number(height_fraction));
-    if (!in_range(height_m, 10, true))
-        return fail(field(p, height_m_name) + ": must be in [0, 10] m (0 = from the fraction), got " + number(height_m));
-    if (!in_range(torso_fraction, 1))
-        return fail(field(p, "torso_radius_fraction") + ": must be in (0, 1], got " + number(torso_fraction));
-    if (fitting_rows < 1 || fitting_rows >= per_line)
-        return fail(field(p, "fitting_rows") + ": must be in [1, particles_per_line), got " + std::to_string(fitting_rows));
-    return validate(material, field(p, "material"));
+// One row of the parameter table against its value: "skirt.length_m: must be in (0, 10] m, got -1".
+Result<void> check(const GarmentParameterSpec& spec, double value, std::string_view p, std::string_view field_name) {
+    if (spec.range.contains(value)) return {};
+    std::string message = field(p, field_name) + ": must be in " + spec.range.text();
+    if (!spec.unit.empty()) message += " " + std::string(spec.unit);
+    message += ", got ";
+    message += spec.kind == ParameterKind::integer ? std::to_string(static_cast<long long>(value)) : number(static_cast<Real>(value));
+    return fail(message);
 }
 
 // Particle-order positions from grid-order positions.
@@ -92,7 +82,7 @@ Garment make_instance(std::shared_ptr<const Fabric> fabric, Matrix3X x, const Cl
     g.fabric = std::move(fabric);
     g.state.x = std::move(x);
     g.state.v = Matrix3X::Zero(3, n);
-    g.state.inv_mass = VectorX::Constant(n, Real(n) / material.mass_kg);
+    g.state.inv_mass = (material.areal_density_kg_m2 * g.fabric->area_m2).cwiseInverse();
     g.config.material = material;
     g.config.model = model;
     g.config.collision = collision;
@@ -112,17 +102,6 @@ Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     if (disc < 0 || a <= 0) return -1;
     return (-b + std::sqrt(disc)) / (2 * a);
 }
-
-struct TubeShape {
-    std::string_view name;
-    int lines, per_line, stride;
-    Real length_m, flare_rad, ease_m, height_fraction, height_m, torso_fraction;
-    int fitting_rows;
-    ClothMaterial material;
-    ClothModel model;
-    CollisionMode collision;
-    Vec3 color;
-};
 
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
@@ -226,8 +205,8 @@ Result<Entity> finish(Registry& registry, Garment g, int rows) {
     return e;
 }
 
-Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape& s) {
-    const std::string p(s.name);
+Result<Entity> attach_tube(Registry& registry, Entity character, std::string_view name, const TubeParams& s) {
+    const std::string p(name);
     if (!registry.valid(character)) return fail(p + ": the character entity is not alive");
     const std::vector<Entity> colliders = character_colliders(registry, character);
     if (colliders.empty()) return fail(p + ": the character has no ellipsoid colliders");
@@ -235,10 +214,13 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
                                            " colliders; a garment handles at most 64");
     std::vector<EllipsoidFrame> frames;
     bool placed = false;
+    std::vector<std::uint8_t> limb;  // arms, hands, head: never part of the body's outline
     for (Entity e : colliders) {
         const auto& c = registry.get<EllipsoidCollider>(e);
         placed = placed || c.initialised;
         frames.push_back(make_ellipsoid_frame(c.world));
+        const BodyRegion r = c.region;
+        limb.push_back(r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::head);
     }
     if (!placed) return fail(p + ": the character's colliders have not been placed yet (run the collider system once)");
 
@@ -256,22 +238,23 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
     if (active == 0) return fail(p + ": the character's colliders are degenerate (zero radii)");
     axis /= Real(active);
     const Real height = top - bottom;
-    const Real ring_y = bottom + (s.height_m > 0 ? s.height_m : s.height_fraction * height);
+    const Real ring_y = bottom + (s.ring_height_m > 0 ? s.ring_height_m : s.ring_height_fraction * height);
     const Vec3 origin(axis.x(), ring_y, axis.z());
 
     // Outline colliders: cross the ring height, near the axis.
     std::vector<std::size_t> outline;
     for (std::size_t e = 0; e < frames.size(); ++e) {
         const EllipsoidFrame& f = frames[e];
-        if (!f.active || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
+        if (!f.active || limb[e] || std::abs(f.center.y() - ring_y) >= half_height(f)) continue;
         const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
-        if (off.norm() > s.torso_fraction * height) continue;
+        if (off.norm() > s.torso_radius_fraction * height) continue;
         outline.push_back(e);
     }
     if (outline.empty())
         return fail(p + ": no collider crosses the ring height " + number(ring_y) + " m near the body axis");
 
-    const int n = s.lines, m = s.per_line;
+    const int n = s.warp_lines, m = s.particles_per_line;
+    const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;
     const Real step = s.length_m / Real(m - 1);
     Matrix3X grid(3, n * m);
     for (int line = 0; line < n; ++line) {
@@ -281,15 +264,29 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
         for (std::size_t e : outline) r = std::max(r, ray_exit(frames[e], origin, d));
         if (r <= 0) return fail(p + ": the body outline at the ring height does not surround the axis");
         r += s.ease_m;
+        // Down the cone, but never closer to the axis than the body below the ring (hips,
+        // thighs, bust) plus the ease: the rest shape must fit over the body, or the cloth
+        // would hang stretched over it. Once widened, the line keeps its width below.
+        Real widest = r;
         for (int row = 0; row < m; ++row) {
             const Real along = step * Real(row);
-            grid.col(line * m + row) =
-                origin + d * (r + along * std::sin(s.flare_rad)) - Vec3::UnitY() * (along * std::cos(s.flare_rad));
+            const Vec3 centre = origin - Vec3::UnitY() * (along * std::cos(flare_rad));
+            Real need = 0;
+            for (std::size_t e = 0; e < frames.size(); ++e) {
+                const EllipsoidFrame& f = frames[e];
+                if (!f.active || limb[e] || std::abs(f.center.y() - centre.y()) >= half_height(f)) continue;
+                const Vec3 off(f.center.x() - axis.x(), 0, f.center.z() - axis.z());
+                if (off.norm() > s.torso_radius_fraction * height) continue;  // arms, hands
+                need = std::max(need, ray_exit(f, centre, d) + s.ease_m);
+            }
+            widest = std::max({widest, r + along * std::sin(flare_rad), need});
+            grid.col(line * m + row) = centre + d * widest;
         }
     }
-    auto topology = build_grid_topology(n, m, s.stride, true, grid, s.name);
+    auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
+    g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular};
     g.body.character = character;
     g.body.colliders = colliders;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
@@ -303,34 +300,20 @@ Result<Entity> attach_tube(Registry& registry, Entity character, const TubeShape
 }  // namespace
 
 Result<void> validate(const ClothMaterial& m, std::string_view p) {
-    if (!in_range(m.mass_kg, 100)) return fail(field(p, "mass_kg") + ": must be in (0, 100], got " + number(m.mass_kg));
-    if (!in_range(m.stretch_k_N_m, 1e7))
-        return fail(field(p, "stretch_k_N_m") + ": must be in (0, 1e7], got " + number(m.stretch_k_N_m));
-    if (!in_range(m.shear_k_N_m, 1e7, true))
-        return fail(field(p, "shear_k_N_m") + ": must be in [0, 1e7], got " + number(m.shear_k_N_m));
-    if (!in_range(m.bend_k_N_m, 1e7, true))
-        return fail(field(p, "bend_k_N_m") + ": must be in [0, 1e7], got " + number(m.bend_k_N_m));
-    if (!in_range(m.drag_N_s_m, 100, true))
-        return fail(field(p, "drag_N_s_m") + ": must be in [0, 100], got " + number(m.drag_N_s_m));
-    if (!std::isfinite(m.strain_limit) || m.strain_limit <= 0 || m.strain_limit > 10)
-        return fail(field(p, "strain_limit") + ": must be in (0, 10], got " + number(m.strain_limit));
-    if (m.strain_iterations < 0 || m.strain_iterations > 100)
-        return fail(field(p, "strain_iterations") + ": must be in [0, 100], got " + std::to_string(m.strain_iterations));
-    if (!in_range(m.candidate_margin_m, 1))
-        return fail(field(p, "candidate_margin_m") + ": must be in (0, 1] m, got " + number(m.candidate_margin_m));
+    for (const GarmentParameterSpec& spec : garment_parameters())
+        if (spec.in_material())
+            if (auto ok = check(spec, spec.get(m), p, spec.name); !ok) return ok;
     return {};
 }
 
-Result<void> validate(const SkirtParams& s) {
-    return validate_tube("skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
-                         s.waist_height_fraction, "waist_height_fraction", s.waist_height_m, "waist_height_m",
-                         s.torso_radius_fraction, s.fitting_rows, s.material);
-}
-
-Result<void> validate(const DressParams& s) {
-    return validate_tube("dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m, s.flare_deg, s.ease_m,
-                         s.shoulder_height_fraction, "shoulder_height_fraction", s.shoulder_height_m,
-                         "shoulder_height_m", s.torso_radius_fraction, s.fitting_rows, s.material);
+Result<void> validate(const TubeParams& s, std::string_view garment) {
+    for (const GarmentParameterSpec& spec : garment_parameters())
+        if (auto ok = check(spec, spec.get(s), garment, spec.field()); !ok) return ok;
+    // What one row cannot say: the grid as a whole, and the pins within it.
+    if (auto ok = validate_grid(garment, s.warp_lines, s.particles_per_line, s.weft_stride, true); !ok) return ok;
+    if (s.fitting_rows >= s.particles_per_line)
+        return fail(field(garment, "fitting_rows") + ": must be in [1, particles_per_line), got " + std::to_string(s.fitting_rows));
+    return {};
 }
 
 Result<void> validate(const RectangleParams& r) {
@@ -362,19 +345,22 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
     const auto is_layer1 = [&](std::uint32_t line) { return line % stride == 0; };
     const auto gi = [&](std::uint32_t line, std::uint32_t row) { return line * m + row; };
 
-    // Particle order: layer-1 lines first (one contiguous block to integrate), then layer 2.
+    // Particle order: layer 1 first (one contiguous block to integrate), then layer 2 by the
+    // lines' place between their layer-1 neighbours (line % stride); within each block row
+    // by row, the block's lines side by side. A row of warp springs of one block, or of weft
+    // springs between two blocks, then joins consecutive particles to consecutive particles:
+    // the solver takes each such row as one strip of independent springs, rows from the
+    // fitting zone down (constraints.hpp).
     t->grid.assign(n * m, 0);
     t->layer.assign(n * m, 0);
     std::uint32_t next = 0;
-    for (int pass = 1; pass <= 2; ++pass)
-        for (std::uint32_t line = 0; line < n; ++line)
-            if (is_layer1(line) == (pass == 1))
-                for (std::uint32_t row = 0; row < m; ++row) {
-                    t->grid[gi(line, row)] = next;
-                    t->layer[next++] = static_cast<std::uint8_t>(pass);
-                }
+    for (std::uint32_t offset = 0; offset < stride; ++offset)
+        for (std::uint32_t row = 0; row < m; ++row)
+            for (std::uint32_t line = offset; line < n; line += stride) {
+                t->grid[gi(line, row)] = next;
+                t->layer[next++] = static_cast<std::uint8_t>(offset == 0 ? 1 : 2);
+            }
     t->layer1_count = static_cast<std::uint32_t>(std::count(t->layer.begin(), t->layer.end(), 1));
-    t->layer1_mass_scale = Real(n * m) / Real(t->layer1_count);
 
     const auto at = [&](std::uint32_t line, std::uint32_t row) { return t->grid[gi(line, row)]; };
     const auto rest = [&](std::uint32_t a_line, std::uint32_t a_row, std::uint32_t b_line, std::uint32_t b_row) {
@@ -387,26 +373,51 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
         if (!(r > Real(1e-6))) degenerate = "two neighbouring particles coincide at rest";
         phase.add(at(al, ar), at(bl, br), r);
     };
-    // Warp springs line by line from the fitting zone (row 0) outward.
+    // Every phase line by line, rows from the fitting zone (row 0) outward: a line's springs
+    // are then runs of consecutive particles, which the solver takes a strip at a time
+    // (constraints.hpp).
     for (std::uint32_t line = 0; line < n; ++line)
         for (std::uint32_t row = 0; row + 1 < m; ++row) add(is_layer1(line) ? t->warp1 : t->warp2, line, row, line, row + 1);
-    for (std::uint32_t row = 0; row < m; ++row)
-        for (std::uint32_t line = 0; line < weft_lines; ++line) add(t->weft, line, row, (line + 1) % n, row);
-    for (std::uint32_t row = 0; row < m; ++row)
-        for (std::uint32_t line = 0; line < n; line += stride)
-            if (closed || line + stride < n) add(t->weft1, line, row, (line + stride) % n, row);
     for (std::uint32_t line = 0; line < weft_lines; ++line)
-        for (std::uint32_t row = 0; row + 1 < m; ++row) {
-            add(t->shear, line, row, (line + 1) % n, row + 1);
-            add(t->shear, (line + 1) % n, row, line, row + 1);
-        }
+        for (std::uint32_t row = 0; row < m; ++row) add(t->weft, line, row, (line + 1) % n, row);
+    for (std::uint32_t line = 0; line < n; line += stride)
+        if (closed || line + stride < n)
+            for (std::uint32_t row = 0; row < m; ++row) add(t->weft1, line, row, (line + stride) % n, row);
+    for (std::uint32_t line = 0; line < weft_lines; ++line) {
+        for (std::uint32_t row = 0; row + 1 < m; ++row) add(t->shear, line, row, (line + 1) % n, row + 1);
+        for (std::uint32_t row = 0; row + 1 < m; ++row) add(t->shear, (line + 1) % n, row, line, row + 1);
+    }
     for (std::uint32_t line = 0; line < n; ++line)
         for (std::uint32_t row = 0; row + 2 < m; ++row) add(t->bend, line, row, line, row + 2);
     const std::uint32_t bend_lines = closed ? n : (n >= 2 ? n - 2 : 0);
     if (n > 2)
-        for (std::uint32_t row = 0; row < m; ++row)
-            for (std::uint32_t line = 0; line < bend_lines; ++line) add(t->bend, line, row, (line + 2) % n, row);
+        for (std::uint32_t line = 0; line < bend_lines; ++line)
+            for (std::uint32_t row = 0; row < m; ++row) add(t->bend, line, row, (line + 2) % n, row);
     if (!degenerate.empty()) return fail(std::string(p) + ": " + degenerate);
+    // Each phase in particle order (strips, see above). A warp spring's `a` stays the end
+    // nearer the fitting zone.
+    for (SpringPhase* phase : {&t->warp1, &t->warp2, &t->weft, &t->weft1, &t->shear, &t->bend}) {
+        std::vector<std::uint32_t> order(phase->size());
+        for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+            return std::pair(phase->a[i], phase->b[i]) < std::pair(phase->a[j], phase->b[j]);
+        });
+        SpringPhase sorted;
+        for (std::uint32_t k : order) sorted.add(phase->a[k], phase->b[k], phase->rest_m[k]);
+        *phase = std::move(sorted);
+    }
+
+    // Rest area per particle: a quarter of each grid quad around it (two triangles).
+    t->area_m2 = VectorX::Zero(n * m);
+    for (std::uint32_t line = 0; line < weft_lines; ++line)
+        for (std::uint32_t row = 0; row + 1 < m; ++row) {
+            const std::uint32_t l1 = (line + 1) % n;
+            const Vec3 p00 = pos.col(gi(line, row)), p01 = pos.col(gi(line, row + 1));
+            const Vec3 p10 = pos.col(gi(l1, row)), p11 = pos.col(gi(l1, row + 1));
+            const Real quad = Real(0.5) * ((p11 - p00).cross(p01 - p10)).norm();
+            for (std::uint32_t corner : {at(line, row), at(line, row + 1), at(l1, row), at(l1, row + 1)})
+                t->area_m2[corner] += quad / 4;
+        }
 
     // Weft placement of layer 2 (method §4.2).
     for (std::uint32_t line = 0; line < n; ++line) {
@@ -417,10 +428,16 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
             t->weft_particle.push_back(at(line, row));
             t->weft_left.push_back(at(left, row));
             t->weft_right.push_back(at(right, row));
-            t->weft_t.push_back(Real(line % stride) / Real(stride));
-            Real segments = 0;
-            for (std::uint32_t k = left; k != right; k = (k + 1) % n) segments += rest(k, row, (k + 1) % n, row);
-            t->weft_rest_m.push_back(segments / Real(stride));
+            // Along the chord in proportion to the rest lengths, so that on the chord every
+            // weft segment has the same strain however uneven the segments are.
+            Real segments = 0, before = 0;
+            for (std::uint32_t k = left; k != right; k = (k + 1) % n) {
+                if (k == line) before = segments;
+                segments += rest(k, row, (k + 1) % n, row);
+            }
+            t->weft_t.push_back(before / segments);
+            t->weft_chord_rest_m.push_back(segments);
+            t->weft_rest_m.push_back(std::min(rest((line + n - 1) % n, row, line, row), rest(line, row, (line + 1) % n, row)));
             t->weft_above.push_back(row > 0 ? at(line, row - 1) : std::numeric_limits<std::uint32_t>::max());
             t->weft_above_rest_m.push_back(row > 0 ? rest(line, row - 1, line, row) : Real(0));
         }
@@ -460,22 +477,14 @@ std::vector<Entity> character_colliders(Registry& registry, Entity character) {
     return out;
 }
 
-Result<Entity> attach_skirt(Registry& registry, Entity character, const SkirtParams& s) {
-    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
-    return attach_tube(registry, character,
-                       TubeShape{"skirt", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
-                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.waist_height_fraction,
-                                 s.waist_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
-                                 s.collision, s.color});
+Result<Entity> attach_skirt(Registry& registry, Entity character, const TubeParams& params) {
+    if (auto ok = validate(params, "skirt"); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character, "skirt", params);
 }
 
-Result<Entity> attach_dress(Registry& registry, Entity character, const DressParams& s) {
-    if (auto ok = validate(s); !ok) return std::unexpected(ok.error());
-    return attach_tube(registry, character,
-                       TubeShape{"dress", s.warp_lines, s.particles_per_line, s.weft_stride, s.length_m,
-                                 s.flare_deg * std::numbers::pi_v<Real> / 180, s.ease_m, s.shoulder_height_fraction,
-                                 s.shoulder_height_m, s.torso_radius_fraction, s.fitting_rows, s.material, s.model,
-                                 s.collision, s.color});
+Result<Entity> attach_dress(Registry& registry, Entity character, const TubeParams& params) {
+    if (auto ok = validate(params, "dress"); !ok) return std::unexpected(ok.error());
+    return attach_tube(registry, character, "dress", params);
 }
 
 Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity> colliders) {

@@ -14,7 +14,8 @@
 //     (weights of the nearest skin vertex when it has a SkinnedMesh, else its collider's
 //     bone), so the pins follow linear blend skinning like the body mesh;
 //   - otherwise bound rigidly to the nearest collider (analytic bodies).
-// Parameter errors name the field ("skirt.length_m: must be > 0").
+// Parameter errors name the field ("skirt.length_m: must be in (0, 10] m, got -1"); the
+// ranges are those of the garment parameter table (systems/cloth/garment_parameters.hpp).
 #pragma once
 
 #include <memory>
@@ -27,43 +28,46 @@
 
 namespace drape {
 
-/// A skirt: a truncated cone hanging from the waist (the fitted hip ellipsoids).
-struct SkirtParams {
+/// A skirt or a dress: a tube hung from a ring around the body, flaring into a truncated
+/// cone (see the placement rules above). A skirt and a dress differ only in their values:
+/// the ring is the waist for a skirt (the fitted hip ellipsoids) and the shoulders for a
+/// dress. The defaults are the skirt's (`skirt()`); `dress()` gives the dress's. Ranges,
+/// units and meanings of the numeric fields: the garment parameter table
+/// (systems/cloth/garment_parameters.hpp), which validate(TubeParams) walks.
+struct TubeParams {
     int warp_lines = 27;              ///< Lines around the body (n); a multiple of weft_stride.
     int particles_per_line = 31;      ///< Particles down each line (m). 27 x 31 = 837.
     int weft_stride = 3;              ///< Every weft_stride-th line is layer 1 (method §3.2).
-    Real length_m = Real(0.55);       ///< Along the cone from the waist to the hem.
-    Real flare_deg = Real(18);        ///< Cone half-angle from vertical, [0, 80].
-    Real ease_m = Real(0.01);         ///< Gap between the waist outline and the cloth.
-    Real waist_height_fraction = Real(0.58);  ///< Waist height / body height (used when waist_height_m is 0).
-    Real waist_height_m = 0;          ///< > 0: waist height above the body's lowest point.
+    Real length_m = Real(0.55);       ///< Along the cone from the ring to the hem.
+    Real flare_deg = Real(18);        ///< Cone half-angle from vertical.
+    Real ease_m = Real(0.01);         ///< Gap between the body outline at the ring and the cloth.
+    Real ring_height_fraction = Real(0.58);  ///< Ring height / body height: the waist (skirt) or the shoulders (dress); used when ring_height_m is 0.
+    Real ring_height_m = 0;           ///< > 0: ring height above the body's lowest point.
     Real torso_radius_fraction = Real(0.12);  ///< Colliders centred farther than this x height from the axis (arms) are not outline.
-    int fitting_rows = 1;             ///< Rows pinned to the body.
+    int fitting_rows = 1;             ///< Rows pinned to the body (method §3.5).
+    Real inertia_linear = 1;          ///< InertiaScales::linear of the garment (1: physical).
+    Real inertia_angular = 1;         ///< InertiaScales::angular.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.75f, 0.12f, 0.18f);
-};
 
-/// A dress: a tube hanging from the shoulders. The default has 120 x 84 = 10,080 particles.
-struct DressParams {
-    int warp_lines = 120;
-    int particles_per_line = 84;
-    int weft_stride = 3;
-    Real length_m = Real(1.05);
-    Real flare_deg = Real(10);
-    Real ease_m = Real(0.015);
-    Real shoulder_height_fraction = Real(0.80);  ///< Ring height / body height (used when shoulder_height_m is 0).
-    Real shoulder_height_m = 0;
-    Real torso_radius_fraction = Real(0.12);
-    int fitting_rows = 2;
-    /// Per-spring stiffness and per-particle drag scaled to the finer grid (same cloth as
-    /// the skirt per unit area), so that the default dress needs one substep too.
-    ClothMaterial material{.mass_kg = Real(0.6), .stretch_k_N_m = Real(0.12), .shear_k_N_m = Real(0.06),
-                           .bend_k_N_m = Real(0.03), .drag_N_s_m = Real(0.00018)};
-    ClothModel model = ClothModel::simplified;
-    CollisionMode collision = CollisionMode::candidate_lists;
-    Vec3 color = Vec3(0.15f, 0.3f, 0.7f);
+    /// The paper's skirt: 27 x 31 = 837 particles hung from the waist.
+    [[nodiscard]] static TubeParams skirt() { return {}; }
+    /// A strapless dress hung from the chest under the arms: 120 x 84 = 10,080 particles, the
+    /// same cloth.
+    [[nodiscard]] static TubeParams dress() {
+        TubeParams p;
+        p.warp_lines = 120;
+        p.particles_per_line = 84;
+        p.length_m = Real(1.05);
+        p.flare_deg = Real(10);
+        p.ease_m = Real(0.015);
+        p.ring_height_fraction = Real(0.72);  // under the arms: the arms stay outside the dress
+        p.fitting_rows = 2;
+        p.color = Vec3(0.15f, 0.3f, 0.7f);
+        return p;
+    }
 };
 
 /// A flat rectangle (tests, demos): lines along +X, rows down -Y (hanging) or along +Z (lying).
@@ -76,7 +80,7 @@ struct RectangleParams {
     Vec3 origin = Vec3(0, 2, 0);      ///< Position of line 0, row 0.
     bool hanging = true;              ///< true: rows go down -Y; false: rows go along +Z (horizontal sheet).
     bool pin_top_row = true;          ///< Pin row 0 in world space.
-    ClothMaterial material{.mass_kg = Real(0.1)};
+    ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.8f, 0.8f, 0.8f);
@@ -88,9 +92,9 @@ struct RectangleParams {
 /// frame (1,000,000 particles: 2.6 s per frame on one core).
 inline constexpr int max_garment_particles = 250'000;
 
-/// Checks parameters; the error names the field.
-[[nodiscard]] Result<void> validate(const SkirtParams& params);
-[[nodiscard]] Result<void> validate(const DressParams& params);
+/// Checks parameters; the error names the field, prefixed with `garment` ("skirt",
+/// "dress"): "skirt.length_m: must be in (0, 10] m, got -1".
+[[nodiscard]] Result<void> validate(const TubeParams& params, std::string_view garment);
 [[nodiscard]] Result<void> validate(const RectangleParams& params);
 [[nodiscard]] Result<void> validate(const ClothMaterial& material, std::string_view prefix);
 
@@ -99,11 +103,12 @@ inline constexpr int max_garment_particles = 250'000;
     int warp_lines, int particles_per_line, int weft_stride, bool closed, const Matrix3X& grid_positions,
     std::string_view prefix);
 
-/// Skirt on `character` (see the placement rules above). Returns the garment entity.
-[[nodiscard]] Result<Entity> attach_skirt(Registry& registry, Entity character, const SkirtParams& params);
+/// Skirt on `character` (see the placement rules above): a tube whose errors are named
+/// "skirt.<field>". Returns the garment entity.
+[[nodiscard]] Result<Entity> attach_skirt(Registry& registry, Entity character, const TubeParams& params = TubeParams::skirt());
 
-/// Dress on `character`. Returns the garment entity.
-[[nodiscard]] Result<Entity> attach_dress(Registry& registry, Entity character, const DressParams& params);
+/// Dress on `character`: a tube whose errors are named "dress.<field>". Returns the garment entity.
+[[nodiscard]] Result<Entity> attach_dress(Registry& registry, Entity character, const TubeParams& params = TubeParams::dress());
 
 /// A flat rectangle, pinned in world space, colliding with `colliders` (no body).
 [[nodiscard]] Result<Garment> make_rectangle(const RectangleParams& params, std::span<const Entity> colliders = {});

@@ -1,6 +1,9 @@
 // The cloth module's per-garment caches; see garment_solver.hpp.
 #include "systems/cloth/garment_solver.hpp"
 
+#include <algorithm>
+#include <limits>
+
 #include "systems/cloth/integrator.hpp"
 
 namespace drape {
@@ -8,19 +11,87 @@ namespace drape {
 void invalidate(GarmentSolver& s) {
     s.configured = false;
     s.lists.valid = false;
+    s.weft_offsets_valid = false;
 }
+
+namespace {
+
+// The solver's masses and drags: the state's (1 / inverse mass, material drag x area); in the
+// simplified model each layer-2 particle's shares go to the layer-1 ends of its chord.
+void derive_masses(const Garment& g, GarmentSolver& s) {
+    const Fabric& t = *g.fabric;
+    const VectorX& w = g.state.inv_mass;
+    const Eigen::Index n = w.size();
+    VectorX mass = VectorX::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i) mass[i] = w[i] > 0 ? 1 / w[i] : Real(0);
+    VectorX drag = g.config.material.drag_N_s_m3 * t.area_m2;
+    if (g.config.model == ClothModel::simplified) {
+        for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+            const std::uint32_t p = t.weft_particle[k], a = t.weft_left[k], b = t.weft_right[k];
+            const Real share = t.weft_t[k];
+            if (w[p] == 0) continue;  // pinned in the fitting zone: the skin carries it
+            mass[a] += (1 - share) * mass[p];
+            mass[b] += share * mass[p];
+            drag[a] += (1 - share) * drag[p];
+            drag[b] += share * drag[p];
+        }
+    }
+    s.inv_mass = VectorX::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i) s.inv_mass[i] = w[i] > 0 && mass[i] > 0 ? 1 / mass[i] : Real(0);
+    s.drag_N_s_m = drag;
+}
+
+SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus, bool limited) {
+    SpringSet set;
+    set.springs = &phase;
+    set.strips = spring_strips(phase);
+    set.compliance = spring_compliance(phase, area, modulus);
+    set.lambda.assign(phase.size(), 0);
+    set.limited = limited;
+    return set;
+}
+
+}  // namespace
 
 void prepare_solver(const Garment& g, GarmentSolver& s) {
     const Fabric& t = *g.fabric;
     const GarmentState& state = g.state;
     const Eigen::Index n = static_cast<Eigen::Index>(t.particle_count());
-    if (!s.configured || !(s.built_for == g.config)) {
-        // What depends on the model and the material: the stability bounds and the lists' margin.
-        s.stable_step_s[0] = stable_step_s(t, g.config.material, state.inv_mass, ClothModel::simplified);
-        s.stable_step_s[1] = stable_step_s(t, g.config.material, state.inv_mass, ClothModel::classic);
-        if (s.configured && s.built_for.material.candidate_margin_m != g.config.material.candidate_margin_m)
-            s.lists.valid = false;
+    const bool simplified = g.config.model == ClothModel::simplified;
+    if (!s.configured || !(s.built_for == g.config) || s.built_fabric != &t || s.built_pins != state.pins.size()) {
+        if (s.configured && s.built_for.material.candidate_margin_m != g.config.material.candidate_margin_m) s.lists.valid = false;
+        const ClothMaterial& m = g.config.material;
+        s.integrated = simplified ? static_cast<Eigen::Index>(t.layer1_count) : n;
+        derive_masses(g, s);
+        // Stiffness from the cloth's moduli and the areas the springs' particles stand for:
+        // a layer-1 particle of the simplified model stands for its weft shares too.
+        VectorX area = t.area_m2;
+        if (simplified)
+            for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+                const Real share = t.weft_t[k];
+                area[t.weft_left[k]] += (1 - share) * t.area_m2[t.weft_particle[k]];
+                area[t.weft_right[k]] += share * t.area_m2[t.weft_particle[k]];
+            }
+        s.springs.clear();
+        if (simplified) {
+            // Layer 1's springs (with the areas its particles stand for), then layer 2's.
+            s.springs.push_back(spring_set(t.weft1, area, m.stretch_N_m, true));
+            s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true));
+            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
+            s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true));
+        } else {
+            // Shear and bend first: the structural springs and their limit have the last word.
+            s.springs.push_back(spring_set(t.shear, area, m.shear_N_m, false));
+            s.springs.push_back(spring_set(t.bend, area, m.bend_N_m, false));
+            s.springs.push_back(spring_set(t.weft, area, m.stretch_N_m, true));
+            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
+            s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true));
+        }
+        s.tethers = build_tethers(t, state.inv_mass, static_cast<std::uint32_t>(s.integrated));
+        s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;
+        s.built_fabric = &t;
+        s.built_pins = state.pins.size();
         s.configured = true;
     }
     if (s.force.cols() != n) s.force = Matrix3X::Zero(3, n);
@@ -28,14 +99,10 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
     if (s.plane_normal.cols() != n) s.plane_normal = Matrix3X::Zero(3, n);
     if (s.movable.size() != static_cast<std::size_t>(n)) {
         s.movable.resize(static_cast<std::size_t>(n));
-        s.movable_weft.resize(static_cast<std::size_t>(n));
-        for (Eigen::Index i = 0; i < n; ++i) {
-            const std::size_t k = static_cast<std::size_t>(i);
-            s.movable[k] = state.inv_mass[i] != 0;
-            s.movable_weft[k] = state.inv_mass[i] != 0 && t.layer[k] == 2;
-        }
+        for (Eigen::Index i = 0; i < n; ++i) s.movable[static_cast<std::size_t>(i)] = state.inv_mass[i] != 0;
     }
     if (s.last_collided.size() != static_cast<std::size_t>(n)) s.last_collided.assign(static_cast<std::size_t>(n), 0);
+    if (s.contacts.size() != static_cast<std::size_t>(n)) s.contacts.assign(static_cast<std::size_t>(n), 0);
 }
 
 }  // namespace drape

@@ -14,6 +14,7 @@
 
 #include "components/garment.hpp"
 #include "engine/core/math.hpp"
+#include "systems/cloth/constraints.hpp"
 
 namespace drape {
 
@@ -38,26 +39,45 @@ struct CandidateLists {
     Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
     VectorX slack_m;                         ///< Per particle: how far it may still move before its list could miss a collider, after the last update, m.
     Matrix3XRows scratch;                    ///< Anchor-frame positions, reused every substep.
+    std::vector<Eigen::Index> spent;         ///< Scratch: the particles whose list is refreshed.
 };
 
 struct GarmentSolver {
     GarmentConfig built_for;                 ///< The configuration the caches below were made for.
+    const Fabric* built_fabric = nullptr;    ///< And the fabric.
+    std::size_t built_pins = 0;              ///< And the number of pins.
     bool configured = false;                 ///< False until the first step (or after invalidate()).
+
+    // Derived from the fabric, the pins and the configuration (prepare_solver).
+    Eigen::Index integrated = 0;             ///< Particles [0, integrated) are integrated (simplified: layer 1).
+    VectorX inv_mass;                        ///< Of every particle as the solver moves it: a layer-1 particle of the
+                                             ///< simplified model carries the mass of the weft particles placed from it.
+    VectorX drag_N_s_m;                      ///< eq. 2's k per particle, with the same shares.
+    std::vector<SpringSet> springs;          ///< The springs the model solves, in order.
+    Tethers tethers;                         ///< Long-range attachments from the pins.
+    Real drag_step_s = 0;                    ///< Largest stable step of the explicit drag.
 
     std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep, one per GarmentBody::colliders.
     std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep (temporal coherence).
     CandidateLists lists;
 
     Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
-    std::array<Real, 2> stable_step_s{0, 0}; ///< Stability bound per model (method §3.4).
+    Matrix2X weft_offsets;                   ///< Simplified: each layer-2 particle's place in its plane (weft.hpp).
+    bool weft_offsets_valid = false;         ///< False: taken from the positions at the next step.
+    Vec3 anchor_velocity_before = Vec3::Zero();      ///< The anchor's V when the velocities were last written.
+    Vec3 anchor_angular_before = Vec3::Zero();       ///< Its W then.
+    bool anchor_known = false;               ///< False: no step yet (the anchor's motion so far counts as none).
 
     // Scratch (no allocation per step once sized).
-    Matrix3X force;                          ///< Spring forces, N.
-    Matrix3X x_start;                        ///< Positions at the start of the substep (contact velocities).
+    Matrix3X x_start;                        ///< Positions at the start of the substep.
+    Matrix3X x_round;                        ///< Positions before the current collision round.
+    Matrix3XRows x_rows;                     ///< Positions one row per coordinate, for the constraint rounds.
+    Matrix3X push;                           ///< Per particle: the collision rounds' push-outs this substep.
+    std::vector<std::uint64_t> contacts;     ///< Per particle: ellipsoids it touched in this substep's rounds.
     Matrix3X normals;                        ///< Layer-1 normals for weft placement.
     Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.
     std::vector<std::uint8_t> movable;       ///< Per particle: 1 unless pinned.
-    std::vector<std::uint8_t> movable_weft;  ///< Per particle: 1 for free layer-2 particles.
+    Matrix3X force;                          ///< Scratch of 3 x particles.
 };
 
 /// Sizes the scratch arrays and masks for `garment` and drops the caches that depend on a

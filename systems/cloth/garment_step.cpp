@@ -2,6 +2,7 @@
 #include "systems/cloth/garment_step.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 
@@ -10,7 +11,7 @@
 #include "systems/cloth/collision.hpp"
 #include "systems/cloth/integrator.hpp"
 #include "systems/cloth/pins.hpp"
-#include "systems/cloth/strain_limit.hpp"
+#include "systems/cloth/constraints.hpp"
 #include "systems/cloth/weft.hpp"
 
 namespace drape {
@@ -29,85 +30,135 @@ void begin_garment_step(const Registry& registry, Garment& g, GarmentSolver& s, 
     update_pin_targets(registry, g, s, false);
 }
 
+namespace {
+
+// The anchor's rigid motion over the substep (integrator.hpp); none without an anchor.
+AnchorMotion anchor_motion(const Registry& registry, const Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    AnchorMotion m;
+    const GarmentBody& body = g.body;
+    if (body.anchor < 0 || static_cast<std::size_t>(body.anchor) >= body.colliders.size()) return m;
+    const auto* c = registry.try_get<EllipsoidCollider>(body.colliders[static_cast<std::size_t>(body.anchor)]);
+    if (c == nullptr) return m;
+    const EllipsoidFrame f0 = interpolate_collider(*c, Real(sub.index) / Real(sub.count));
+    const EllipsoidFrame f1 = interpolate_collider(*c, Real(sub.index + 1) / Real(sub.count));
+    if (!f0.active || !f1.active) return m;
+    m.r0 = f0.rotation;
+    m.c0 = f0.center;
+    m.r1 = f1.rotation;
+    m.c1 = f1.center;
+    m.velocity_m_s = f1.velocity_m_s;
+    m.angular_velocity_rad_s = f1.angular_velocity_rad_s;
+    m.acceleration_m_s2 = f1.acceleration_m_s2;
+    m.velocity_before_m_s = s.anchor_known ? s.anchor_velocity_before : m.velocity_m_s;
+    m.angular_velocity_before_rad_s = s.anchor_known ? s.anchor_angular_before : m.angular_velocity_rad_s;
+    return m;
+}
+
+}  // namespace
+
 void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
-    const Fabric& t = *g.fabric;
     GarmentState& state = g.state;
-    const Real h = static_cast<Real>(sub.h_s);
-
     s.x_start = state.x;  // no allocation once sized
-    // The body part carrying the garment at the start of the substep (method §3.3).
-    BodyMotion body;
-    const GarmentBody& worn = g.body;
-    if (worn.anchor >= 0 && static_cast<std::size_t>(worn.anchor) < worn.colliders.size()) {
-        if (const auto* c = registry.try_get<EllipsoidCollider>(worn.colliders[static_cast<std::size_t>(worn.anchor)])) {
-            const EllipsoidFrame f = interpolate_collider(*c, Real(sub.index) / Real(sub.count));
-            body = BodyMotion{f.center, f.velocity_m_s, f.acceleration_m_s2, f.angular_velocity_rad_s};
-        }
-    }
+    s.push.setZero(3, state.x.cols());
+    std::fill(s.contacts.begin(), s.contacts.end(), 0);
+    for (SpringSet& set : s.springs) std::fill(set.lambda.begin(), set.lambda.end(), Real(0));
+    const AnchorMotion motion = anchor_motion(registry, g, s, sub);
     const Vec3 gravity(0, -standard_gravity_m_s2, 0);
-    const ClothMaterial& m = g.config.material;
-    if (g.config.model == ClothModel::simplified) {
-        const Eigen::Index count = static_cast<Eigen::Index>(t.layer1_count);
-        const Real scale = t.layer1_mass_scale;
-        s.force.leftCols(count).setZero();
-        add_spring_forces(t.warp1, m.stretch_k_N_m * scale, state.x, s.force);
-        add_spring_forces(t.weft1, m.stretch_k_N_m, state.x, s.force);
-        integrate_particles(state.x, state.v, state.inv_mass, s.force, count, scale, m.drag_N_s_m, body, gravity, h);
-    } else {
-        s.force.setZero();
-        add_spring_forces(t.warp1, m.stretch_k_N_m, state.x, s.force);
-        add_spring_forces(t.warp2, m.stretch_k_N_m, state.x, s.force);
-        add_spring_forces(t.weft, m.stretch_k_N_m, state.x, s.force);
-        add_spring_forces(t.shear, m.shear_k_N_m, state.x, s.force);
-        add_spring_forces(t.bend, m.bend_k_N_m, state.x, s.force);
-        integrate_particles(state.x, state.v, state.inv_mass, s.force, state.x.cols(), 1, m.drag_N_s_m, body, gravity, h);
-    }
+    predict_particles(state.x, state.v, s.inv_mass, s.drag_N_s_m, s.integrated, motion, g.config.inertia, gravity,
+                      static_cast<Real>(sub.h_s));
+    s.anchor_velocity_before = motion.velocity_m_s;
+    s.anchor_angular_before = motion.angular_velocity_rad_s;
+    s.anchor_known = true;
     apply_pins(g, s, sub.index, sub.count, static_cast<Real>(sub.fixed_dt_s));
 }
 
-void constrain_garment(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+int constraint_rounds(const Garment& g) noexcept { return std::max(1, g.config.material.iterations); }
+
+void prepare_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    prepare_solver(g, s);
+    update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
+}
+
+void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int round) {
+    prepare_solver(g, s);
+    const Fabric& t = *g.fabric;
+    Matrix3X& x = g.state.x;
+    const Real h = static_cast<Real>(sub.h_s);
+    const Real limit = g.config.material.strain_limit;
+    if (round == 0 && g.config.model == ClothModel::simplified) {
+        // §4.2: layer 2 placed in its planes from layer 1 (weft.hpp). Its places were taken
+        // at the end of the last substep, with the layer-1 positions of then.
+        if (!s.weft_offsets_valid) {
+            compute_layer1_normals(t, s.x_start, s.normals);
+            record_weft_offsets(t, s.normals, s.x_start, s.weft_offsets);
+            s.weft_offsets_valid = true;
+        }
+        compute_layer1_normals(t, x, s.normals);
+        place_weft(t, s.normals, g.state.inv_mass, s.weft_offsets, x, s.plane_normal);
+    }
+    s.x_rows = x;  // one row per coordinate: the strips run in vector lanes
+    for (SpringSet& set : s.springs) solve_springs(set, s.x_rows, s.inv_mass, h, limit);
+    solve_tethers(s.tethers, s.x_rows);
+    x = s.x_rows;
+}
+
+void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSubstep&, int) {
+    prepare_solver(g, s);
+    // The constraints moved the particles since the last round: the lists are brought up to
+    // date for where they are now (only what moved far enough is refreshed, collision.hpp).
+    if (g.config.collision == CollisionMode::candidate_lists) update_candidate_lists(g, s);
+    Matrix3X& x = g.state.x;
+    s.x_round = x;
+    collide_range(g, s, 0, x.cols(), nullptr, /*respond_velocity=*/false);
+    for (std::size_t p = 0; p < s.contacts.size(); ++p) s.contacts[p] |= s.last_collided[p];
+    s.push += x - s.x_round;
+}
+
+void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
     const Fabric& t = *g.fabric;
     Matrix3X& x = g.state.x;
     Matrix3X& v = g.state.v;
-    StrainLimitOptions o;
-    o.limit = g.config.material.strain_limit;
-    o.iterations = g.config.material.strain_iterations;
-    o.h_s = static_cast<Real>(sub.h_s);
-    if (g.config.model == ClothModel::simplified) {
-        // §4.1: layer 1, the weft springs between its lines symmetric only, then the warp
-        // with its ordered pass last so that the 10 % bound holds exactly on the warp.
-        StrainLimitOptions weft1 = o;
-        weft1.ordered_pass = false;
-        limit_strain(t.weft1, x, v, s.movable, weft1);
-        limit_strain(t.warp1, x, v, s.movable, o);
-        // §4.2: layer 2 placed in its planes from layer 1. Provot on the layer-2 springs
-        // (item 3) is part of the placement: each particle's one free coordinate is kept where
-        // its warp spring and weft segments hold the limit (weft.hpp), so after this no
-        // layer-2 warp spring below a free particle exceeds 1.10 x rest either.
-        // Under the fitting zone, chords out of reach of the pinned particle above them are
-        // lifted first (weft.hpp); the layer-1 warp then gets its ordered pass again.
-        if (lift_chords_below_pins(t, g.state.inv_mass, x, v, s.force, o.h_s, o.limit)) {
-            StrainLimitOptions ordered = o;
-            ordered.iterations = 0;
-            limit_strain(t.warp1, x, v, s.movable, ordered);
+    const Real h = static_cast<Real>(sub.h_s);
+    const Real friction = g.config.material.friction;
+    // Every free particle, layer 2 too: its placement's velocity (weft.hpp) followed by the
+    // rounds' moves, as Provot's velocities follow his corrections.
+    for (Eigen::Index p = 0; p < x.cols(); ++p) {
+        if (s.inv_mass[p] == 0) continue;  // pins: their velocity is the skin's
+        const Vec3 moved = (x.col(p) - s.x_start.col(p)) / h;
+        const std::uint64_t touched = s.contacts[static_cast<std::size_t>(p)];
+        if (touched == 0) {
+            v.col(p) = moved;
+            continue;
         }
-        compute_layer1_normals(t, x, s.normals);
-        place_weft(t, s.normals, g.state.inv_mass, x, v, s.plane_normal, o.h_s, o.limit);
-    } else {
-        StrainLimitOptions weft = o;
-        weft.ordered_pass = false;
-        limit_strain(t.weft, x, v, s.movable, weft);
-        limit_strain(t.warp1, x, v, s.movable, o);
-        limit_strain(t.warp2, x, v, s.movable, o);
+        // In contact: the motion along the surface is the particle's (it slides, slowed by
+        // Coulomb friction); across it, the push-outs are not motion: it keeps the normal
+        // velocity it had without them where that leaves the surface, else the surface's.
+        const Vec3 unpushed = moved - s.push.col(p) / h;
+        Vec3 vp = moved;
+        for (std::uint64_t bits = touched; bits != 0; bits &= bits - 1) {
+            const EllipsoidFrame& f = s.frames[static_cast<std::size_t>(std::countr_zero(bits))];
+            if (!f.active) continue;
+            const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, x.col(p))).normalized();
+            if (!normal.allFinite()) continue;
+            const Vec3 surface = body_velocity_at(f, x.col(p));
+            const Real away = (unpushed - surface).dot(normal);
+            Vec3 tangential = (vp - surface) - (vp - surface).dot(normal) * normal;
+            if (away < 0) {
+                const Real t_len = tangential.norm();
+                if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
+            }
+            vp = surface + tangential + std::max(away, Real(0)) * normal;
+        }
+        v.col(p) = vp;
     }
-}
-
-void record_strain(Garment& g) {
-    const Fabric& t = *g.fabric;
-    const Matrix3X& x = g.state.x;
-    g.counters.max_strain = std::max({max_strain(t.warp1, x), max_strain(t.warp2, x), max_strain(t.weft, x)});
+    if (g.config.model == ClothModel::simplified) {
+        // §4.2 item 1: layer 2's places in its planes where the rounds left it.
+        compute_layer1_normals(*g.fabric, x, s.normals);
+        record_weft_offsets(*g.fabric, s.normals, x, s.weft_offsets);
+        s.weft_offsets_valid = true;
+    }
 }
 
 std::uint64_t count_non_finite(const Garment& g) {
@@ -120,12 +171,7 @@ namespace {
 bool all_finite(const Matrix3X& m) { return !std::isnan((m.array() * 0).sum()); }
 }  // namespace
 
-void collide_garment_step(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
-    prepare_solver(g, s);
-    update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
-    const CollisionResult r = collide_garment(g, s, nullptr, static_cast<Real>(sub.h_s));
-    g.counters.unresolved += r.unresolved;
-
+void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep&) {
     // A NaN or infinity must not spread: report it once, count it, and start again from rest.
     if (!all_finite(g.state.x) || !all_finite(g.state.v)) {
         const std::uint64_t bad = count_non_finite(g);
@@ -140,16 +186,24 @@ int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double 
                  const ClothSolverSettings& settings, const StepHooks& hooks) {
     const int substeps = garment_substeps(registry, g, s, fixed_dt_s, settings);
     begin_garment_step(registry, g, s, substeps);
+    const int rounds = constraint_rounds(g);
     for (int i = 0; i < substeps; ++i) {
         const ClothSubstep sub = make_substep(i, substeps, fixed_dt_s);
         integrate_garment(registry, g, s, sub);
-        constrain_garment(g, s, sub);
-        if (sub.last()) record_strain(g);
+        prepare_collision(registry, g, s, sub);
+        for (int round = 0; round < rounds; ++round) {
+            constrain_round(g, s, sub, round);
+            if (hooks.collide_round)
+                hooks.collide_round(g, s, sub);
+            else
+                collide_round(registry, g, s, sub, round);
+        }
+        finish_constraints(g, s, sub);
         if (hooks.after_constraints) hooks.after_constraints(g, s, sub);
         if (hooks.collide)
             hooks.collide(g, s, sub);
         else
-            collide_garment_step(registry, g, s, sub);
+            finish_collision(registry, g, s, sub);
         if (hooks.after_collision) hooks.after_collision(g, s, sub);
     }
     return substeps;
@@ -174,6 +228,8 @@ void reset_garment_state(const Registry& registry, Garment& g, GarmentSolver& s)
     }
     std::fill(s.last_collided.begin(), s.last_collided.end(), 0);
     s.lists.valid = false;
+    s.anchor_known = false;
+    s.weft_offsets_valid = false;
     collide_garment(g, s);
     ++g.counters.resets;
 }

@@ -1,14 +1,21 @@
 // One garment through one fixed step, in the order the cloth systems run it. Each stage
-// function is the whole per-garment body of its system; `step_garment` runs them all for one
+// function is the per-garment body of its system; `step_garment` runs them all for one
 // garment by hand (tests, tools), so nothing needs a scheduler.
 //
-// Order of a fixed step (method §1 item 4):
-//   begin_garment_step      counters restart, pin targets for the end of the step (§3.5)
+// Order of a fixed step (method §1 item 4; docs/cloth.md "Solver"):
+//   begin_garment_step        counters restart, pin targets for the end of the step (§3.5)
 //   for each substep:
-//     integrate_garment     method §3.3-§3.4, then the pins
-//     constrain_garment     method §4.1 warp, §4.2 weft
-//     collide_garment_step  method §5, then the non-finite check
-//   record_strain after the constraints of the last substep.
+//     integrate_garment       cloth_integration: eq. 2 prediction (§3.3-§3.4), then the pins
+//     prepare_collision       cloth_collision: colliders at the end of the substep
+//     `rounds` times:
+//       constrain_round       cloth_constraint: (first round, simplified) layer 2 placed from
+//                             layer 1 (§4.2); tethers, springs, Provot's limit (§4.1, §4.2)
+//       collide_round         cloth_collision: candidate lists brought up to date, then
+//                             every particle out of the ellipsoids (§5), positions only
+//     finish_constraints      cloth_constraint: velocities of the integrated particles from
+//                             the substep's move without the push-outs, then contacts (no
+//                             approach, friction)
+//     finish_collision        cloth_collision: the non-finite check
 #pragma once
 
 #include <functional>
@@ -35,29 +42,40 @@ struct ClothSubstep {
 /// Before the first substep: restarts the step's counters and sets the pins' targets.
 void begin_garment_step(const Registry& registry, Garment& garment, GarmentSolver& solver, int substeps);
 
-/// Forces and symplectic Euler on the integrated particles (simplified: layer 1; classic:
-/// all), then pins.
+/// Eq. 2's prediction of the integrated particles (simplified: layer 1; classic: all) relative
+/// to the anchor frame (integrator.hpp), then the pins.
 void integrate_garment(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
-/// Provot on the warp; simplified: weft placement and Provot on the weft (§4.2); classic:
-/// Provot on warp and weft.
-void constrain_garment(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
+/// Places the colliders at the end of the substep.
+void prepare_collision(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
-/// Collision against the colliders at the end of the substep, then the non-finite check:
-/// a garment with a NaN or infinity is reported on stderr, counted, and reset.
-void collide_garment_step(const Registry& registry, Garment& garment, GarmentSolver& solver,
-                          const ClothSubstep& substep);
+/// One Gauss-Seidel round of tethers, springs and Provot's limit (constraints.hpp); in the
+/// simplified model the first round starts with the weft placement (weft.hpp).
+void constrain_round(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep, int round);
 
-/// Records the largest warp/weft strain in the garment's counters (after the constraints
-/// of the last substep).
-void record_strain(Garment& garment);
+/// One round of collision of every particle, positions only.
+void collide_round(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep,
+                   int round);
+
+/// After the rounds: velocities of the integrated particles from their move over the substep,
+/// push-outs left out; where a particle touched an ellipsoid, no velocity toward it relative
+/// to its surface and Coulomb friction.
+void finish_constraints(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
+
+/// After the rounds: the non-finite check: a garment with a NaN or infinity is reported on
+/// stderr, counted, and reset.
+void finish_collision(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
+
+/// Constraint rounds per substep of the garment's material.
+[[nodiscard]] int constraint_rounds(const Garment& garment) noexcept;
 
 /// Hooks for stepping by hand: each, when set, is called with the substep.
 struct StepHooks {
     using Hook = std::function<void(Garment&, GarmentSolver&, const ClothSubstep&)>;
-    Hook after_constraints;  ///< After constrain_garment.
-    Hook collide;            ///< In place of collide_garment_step.
-    Hook after_collision;    ///< After the collision stage.
+    Hook collide_round;      ///< In place of each collide_round.
+    Hook after_constraints;  ///< After finish_constraints.
+    Hook collide;            ///< In place of finish_collision.
+    Hook after_collision;    ///< After finish_collision.
 };
 
 /// One fixed step of one garment, exactly as the cloth systems run it (substeps from the

@@ -1,16 +1,26 @@
-// Forces and time integration of the mass-spring garment (method §3.3, §3.4).
+// The explicit part of the garment's motion (method §3.3, §3.4): paper eq. 2 without its
+// spring term (the springs are constraints, constraints.hpp), integrated by symplectic
+// Euler relative to the frame of the body part the garment hangs from.
 //
-// Step order of one substep (cloth integration system):
-//   1. F_springs: Hooke forces of the stretch springs (simplified: the stretch springs
-//      joining layer-1 particles, along the warp and to the next layer-1 line along the
-//      weft; classic: warp, weft, shear and bend springs on the full grid).
-//   2. Per free particle, the force of paper eq. 2 in the frame of the body (the anchor
-//      collider translating with velocity v_b and acceleration a_b at the particle):
-//          F = -m a_b - k (v_b + a_b h/2) - k v_rel + m g + F_springs,  v_rel = v - v_b.
-//   3. Symplectic Euler (§3.4) on world velocities: the body frame itself accelerates by
-//      a_b, so the world velocity changes by h (F/m + a_b); then x += h v.
-// All terms use time-t values (explicit scheme). Pinned particles (inv_mass 0) are left to
-// the pins.
+// Conventions
+// - The anchor frame is the anchor collider's rigid frame (rotation R, centre c). Over a
+//   fixed step it moves with velocity V and angular velocity W (constant over the step;
+//   V_prev and W_prev when the particles' velocities were last written); over a substep it
+//   goes from (R0, c0) to (R1, c1).
+// - A particle's place and velocity relative to the frame: r = R0^T (x - c0),
+//   u = R0^T (v - V_prev - W_prev x (x - c0)). Paper eq. 2 in that frame:
+//       m du/dt = -m s_lin a_b - k (v_b + a_b h/2) - k v_rel + m g
+//                 - m s_ang (2 W x u + W x (W x r) + dW/dt x r)
+//   with v_b = V + W x (x - c0) the body's velocity at the particle, a_b the anchor's
+//   acceleration, k the particle's air drag (material drag per area x its area), and the
+//   inertia scales s_lin, s_ang (InertiaScales: 1 is physical, 0 carries the particle
+//   rigidly with the frame). The frame's velocity changes once per fixed step, so the
+//   inertial terms -m s_lin a_b and -m s_ang dW/dt x r act as the impulse
+//   -s_lin (V - V_prev) - s_ang (W - W_prev) x (x - c0) at the step's first substep.
+// - Symplectic Euler: u += h du/dt, r += h u; then back to the world with the frame at the
+//   end of the substep: x = R1 r + c1, v = R1 u + V + W x (x - c1). With both scales 1 this
+//   is the world-frame motion; with 0 a particle at rest in the frame stays at rest in it.
+// Pinned particles (inverse mass 0) are left to the pins.
 #pragma once
 
 #include "components/garment.hpp"
@@ -18,28 +28,23 @@
 
 namespace drape {
 
-/// Adds the Hooke forces of `springs` (stiffness k, N/m) to `force` (one column per particle).
-void add_spring_forces(const SpringPhase& springs, Real k_N_m, const Matrix3X& x, Matrix3X& force);
-
-/// Rigid motion of the body part that carries the garment (method §3.3).
-struct BodyMotion {
-    Vec3 center = Vec3::Zero();                  ///< A point of the body part, m.
-    Vec3 velocity_m_s = Vec3::Zero();            ///< Of that point.
-    Vec3 acceleration_m_s2 = Vec3::Zero();
-    Vec3 angular_velocity_rad_s = Vec3::Zero();
+/// The anchor's rigid motion over one substep.
+struct AnchorMotion {
+    Mat3 r0 = Mat3::Identity(), r1 = Mat3::Identity();  ///< Rotation at the start and end of the substep.
+    Vec3 c0 = Vec3::Zero(), c1 = Vec3::Zero();          ///< Centre at the start and end.
+    Vec3 velocity_m_s = Vec3::Zero();                   ///< V.
+    Vec3 angular_velocity_rad_s = Vec3::Zero();         ///< W.
+    Vec3 velocity_before_m_s = Vec3::Zero();            ///< V_prev.
+    Vec3 angular_velocity_before_rad_s = Vec3::Zero();  ///< W_prev.
+    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b (eq. 2's drag term).
 };
 
-/// Paper eq. 2 and symplectic Euler on particles [0, count). `mass_scale` multiplies the
-/// mass and drag of each particle (a layer-1 particle stands for its weft neighbours);
-/// `force` must already hold F_springs for the same scale.
-void integrate_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const Matrix3X& force,
-                         Eigen::Index count, Real mass_scale, Real drag_N_s_m, const BodyMotion& body,
-                         const Vec3& gravity_m_s2, Real h_s);
+/// Prediction of particles [0, count): `drag` is each particle's k (N s/m).
+void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const VectorX& drag_N_s_m,
+                       Eigen::Index count, const AnchorMotion& anchor, const InertiaScales& inertia,
+                       const Vec3& gravity_m_s2, Real h_s);
 
-/// Largest stable explicit step (method §3.4) of the garment under `model`: h = 2 / sqrt(lambda)
-/// with lambda the Gershgorin bound of M^-1 K over the integrated particles (each spring
-/// adds k to both ends' rows, twice when the other end moves too), also kept below m / k_drag.
-[[nodiscard]] Real stable_step_s(const Fabric& topology, const ClothMaterial& material,
-                                 const VectorX& inv_mass, ClothModel model);
+/// Largest step for which the explicit drag of eq. 2 stays stable: min over particles of m / k.
+[[nodiscard]] Real drag_step_limit_s(const VectorX& inv_mass, const VectorX& drag_N_s_m, Eigen::Index count);
 
 }  // namespace drape

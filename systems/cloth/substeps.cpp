@@ -6,7 +6,6 @@
 
 #include "components/ellipsoid_collider.hpp"
 #include "systems/cloth/body.hpp"
-#include "systems/cloth/integrator.hpp"
 
 namespace drape {
 
@@ -19,8 +18,8 @@ int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver
         return s.fixed_substeps;
     }
     const double cap = std::max(1, s.max_substeps);
-    const double h_stable = double(solver.stable_step_s[g.config.model == ClothModel::simplified ? 0 : 1]) * s.stability_safety;
-    const double stability = std::isfinite(h_stable) && h_stable > 0 ? std::ceil(fixed_dt / h_stable) : cap;
+    const double h_stable = double(solver.drag_step_s) * s.stability_safety;
+    const double stability = h_stable > 0 ? std::ceil(fixed_dt / h_stable) : cap;  // +inf: no bound, one substep
 
     // Fastest collider surface the garment can touch, relative to its anchor.
     double speed = 0;

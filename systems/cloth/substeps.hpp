@@ -1,18 +1,16 @@
 // How many substeps a garment takes in one fixed step (method §3.4).
 //
 // Rule, per garment:
-//   stability: n_s = ceil(fixed_dt / (safety * h_stable)), h_stable = 2 / sqrt(lambda) with
-//              lambda the Gershgorin bound on M^-1 K of the springs the model integrates
-//              (the "h < 2 sqrt(m / k)" bound of one spring, generalised to a particle with
-//              several springs) and h <= m / k_drag;
+//   stability: n_s = ceil(fixed_dt / (safety * h_stable)), h_stable = m / k_drag, the bound
+//              of eq. 2's explicit drag (the springs are constraints in compliance form,
+//              stable at any stiffness: constraints.hpp);
 //   motion:    n_m = ceil(fixed_dt * u / max_surface_travel), u the fastest surface speed
 //              of a collider the garment can touch, relative to the garment's anchor
 //              (|v_e - v_anchor(c_e)| + |w_e - w_anchor| * r_max), so that no collider
 //              surface moves more than max_surface_travel through the cloth per substep;
 //   n = clamp(max(n_s, n_m), 1, max_substeps), or `fixed_substeps` when that is set.
 // The cloth systems run every garment with the largest need of all garments.
-// With the default material the 837-particle simplified skirt needs one substep for
-// stability; walking adds a second when a thigh swings faster than ~2.4 m/s.
+// Walking adds a second substep when a thigh swings faster than ~2.4 m/s relative to the hips.
 #pragma once
 
 #include "components/garment.hpp"

@@ -151,11 +151,12 @@ using StageCheck = std::function<void(Garment&, GarmentSolver&, const ClothSubst
 
 // Steps garment `g` on `body` by hand for `frames` fixed 1/60 s steps through step_garment
 // (the cloth systems' order and substeps), the body posed before each step.
-// `after_constraints` runs right after the constraint system of every substep; `collide`,
-// when given, replaces the collision system. `hold_pose`: the body keeps its pose of t = 0
-// instead of walking.
+// `after_constraints` runs after the constraint system has finished every substep;
+// `collide_round`, when given, replaces each round of the collision system. `hold_pose`: the
+// body keeps its pose of t = 0 instead of walking.
 inline void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, GarmentSolver& solver, int frames,
-                         const StageCheck& after_constraints = {}, const StageCheck& collide = {}, bool hold_pose = false) {
+                         const StageCheck& after_constraints = {}, const StageCheck& collide_round = {},
+                         bool hold_pose = false) {
     const double dt = 1.0 / 60.0;
     for (int frame = 0; frame < frames; ++frame) {
         body.place(registry, hold_pose ? 0.0 : (frame + 1) * dt, false, dt);
@@ -164,8 +165,10 @@ inline void step_by_hand(AnalyticBody& body, Registry& registry, Garment& g, Gar
             hooks.after_constraints = [&](Garment& garment, GarmentSolver& s, const ClothSubstep& sub) {
                 after_constraints(garment, s, sub, frame);
             };
-        if (collide)
-            hooks.collide = [&](Garment& garment, GarmentSolver& s, const ClothSubstep& sub) { collide(garment, s, sub, frame); };
+        if (collide_round)
+            hooks.collide_round = [&](Garment& garment, GarmentSolver& s, const ClothSubstep& sub) {
+                collide_round(garment, s, sub, frame);
+            };
         step_garment(registry, g, solver, dt, ClothSolverSettings{}, hooks);
     }
 }

@@ -79,7 +79,7 @@ TEST(Collision, OverlappingEllipsoidsLeaveNoParticleInside) {
 using Dress = std::function<Entity(Registry&, Entity character, ClothModel, CollisionMode)>;
 
 Entity default_skirt(Registry& registry, Entity character, ClothModel model, CollisionMode mode) {
-    SkirtParams params;
+    TubeParams params = TubeParams::skirt();
     params.model = model;
     params.collision = mode;
     return *attach_skirt(registry, character, params);
@@ -87,7 +87,7 @@ Entity default_skirt(Registry& registry, Entity character, ClothModel model, Col
 
 // A 2,520-particle dress (the default's layout at half the resolution: the test stays quick).
 Entity small_dress(Registry& registry, Entity character, ClothModel model, CollisionMode mode) {
-    DressParams params;
+    TubeParams params = TubeParams::dress();
     params.warp_lines = 60;
     params.particles_per_line = 42;
     params.model = model;
@@ -108,7 +108,7 @@ test::WalkSettings fast_walk() {
 }
 
 // Walks a garment through a whole walk cycle, calling `check(garment, solver, before)` around
-// every collision pass.
+// every collision round.
 template <class F>
 void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dress = default_skirt,
                 test::WalkSettings walk = {}) {
@@ -121,10 +121,8 @@ void walk_cycle(ClothModel model, CollisionMode mode, F&& check, const Dress& dr
     test::step_by_hand(
         body, registry, g, solver, frames, test::StageCheck{},
         [&](Garment& garment, GarmentSolver& s, const ClothSubstep& ctx, int) {
-            update_frames(registry, garment.body, s.frames, Real(ctx.index + 1) / Real(ctx.count));
             check(garment, s, /*before=*/true);
-            const CollisionResult r = collide_garment(garment, s, nullptr, static_cast<Real>(ctx.h_s));
-            garment.counters.unresolved += r.unresolved;
+            collide_round(registry, garment, s, ctx, 0);
             check(garment, s, /*before=*/false);
         });
 }
@@ -397,7 +395,7 @@ TEST(Collision, BruteForceAndListsGiveTheSameGarmentOnAStaticBody) {
         test::WalkSettings still;
         still.hip_swing_rad = still.knee_bend_rad = still.forward_speed_m_s = still.yaw_rad = 0;
         test::AnalyticBody body(registry, still);
-        SkirtParams params;
+        TubeParams params = TubeParams::skirt();
         params.collision = mode;
         const Entity e = *attach_skirt(registry, body.character, params);
         Scheduler scheduler;

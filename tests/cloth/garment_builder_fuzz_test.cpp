@@ -59,13 +59,14 @@ TEST(GarmentBuilderFuzz, RandomRectanglesBuildAndStayFiniteOrGiveOneError) {
         p.model = rng() % 2 ? ClothModel::classic : ClothModel::simplified;
         p.collision = rng() % 2 ? CollisionMode::brute_force : CollisionMode::candidate_lists;
         ClothMaterial& m = p.material;
-        m.mass_kg = any_real(rng, Real(0.1));
-        m.stretch_k_N_m = any_real(rng, Real(0.9));
-        m.shear_k_N_m = any_real(rng, Real(0.45));
-        m.bend_k_N_m = any_real(rng, Real(0.2));
-        m.drag_N_s_m = any_real(rng, Real(0.0012));
+        m.areal_density_kg_m2 = any_real(rng, Real(0.17));
+        m.stretch_N_m = any_real(rng, Real(2000));
+        m.shear_N_m = any_real(rng, Real(100));
+        m.bend_N_m = any_real(rng, Real(10));
+        m.drag_N_s_m3 = any_real(rng, Real(0.3));
+        m.friction = any_real(rng, Real(0.4));
         m.strain_limit = any_real(rng, Real(0.1));
-        m.strain_iterations = rng() % 10 ? 2 : pick(rng, std::array<int, 4>{-1, 0, 1, 1000000});
+        m.iterations = rng() % 10 ? 4 : pick(rng, std::array<int, 4>{-1, 0, 1, 1000000});
         m.candidate_margin_m = any_real(rng, Real(0.08));
 
         Registry registry;

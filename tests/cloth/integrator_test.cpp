@@ -1,12 +1,14 @@
-// Analytic checks of the force model and symplectic Euler (method §3.3, §3.4).
+// Analytic checks of the explicit prediction (paper eq. 2 in the anchor's frame, symplectic
+// Euler; method §3.3, §3.4) and of the springs in compliance form (constraints.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "systems/cloth_systems.hpp"
+#include "systems/cloth/constraints.hpp"
 #include "systems/cloth/garment_builder.hpp"
 #include "systems/cloth/integrator.hpp"
+#include "systems/cloth_systems.hpp"
 
 namespace drape {
 namespace {
@@ -14,12 +16,12 @@ namespace {
 // Symplectic Euler under constant g: v_n = -g n h, y_n = y0 - g h^2 n (n + 1) / 2, so the
 // error against the exact y0 - g t^2 / 2 is exactly g h t / 2 (first order in h).
 TEST(FreeFall, MatchesTheSchemeAndTheAnalyticSolutionWithinItsKnownError) {
-    Matrix3X x = Matrix3X::Zero(3, 1), v = Matrix3X::Zero(3, 1), force = Matrix3X::Zero(3, 1);
-    VectorX inv_mass = VectorX::Constant(1, 50);
+    Matrix3X x = Matrix3X::Zero(3, 1), v = Matrix3X::Zero(3, 1);
+    const VectorX inv_mass = VectorX::Constant(1, 50), drag = VectorX::Zero(1);
     const Real h = Real(1.0 / 120.0);
     const Vec3 g(0, -standard_gravity_m_s2, 0);
     for (int n = 1; n <= 120; ++n) {
-        integrate_particles(x, v, inv_mass, force, 1, 1, 0, BodyMotion{}, g, h);
+        predict_particles(x, v, inv_mass, drag, 1, AnchorMotion{}, InertiaScales{}, g, h);
         const double t = n * double(h);
         const double scheme = -double(standard_gravity_m_s2) * double(h) * double(h) * n * (n + 1) / 2;
         const double exact = -double(standard_gravity_m_s2) * t * t / 2;
@@ -29,7 +31,7 @@ TEST(FreeFall, MatchesTheSchemeAndTheAnalyticSolutionWithinItsKnownError) {
     }
 }
 
-// The whole pipeline (integration, constraints with layer-2 placement, collision without
+// The whole pipeline (integration, constraint and collision rounds, layer-2 placement, no
 // colliders) on a free, unstretched sheet: every particle falls like a single one.
 TEST(FreeFall, WholeSheetFallsRigidlyThroughTheThreeSystems) {
     for (ClothModel model : {ClothModel::simplified, ClothModel::classic}) {
@@ -37,7 +39,7 @@ TEST(FreeFall, WholeSheetFallsRigidlyThroughTheThreeSystems) {
         RectangleParams params;
         params.pin_top_row = false;
         params.hanging = false;
-        params.material.drag_N_s_m = 0;
+        params.material.drag_N_s_m3 = 0;
         params.model = model;
         const Entity e = *attach_rectangle(registry, params);
         Scheduler scheduler;
@@ -57,67 +59,205 @@ TEST(FreeFall, WholeSheetFallsRigidlyThroughTheThreeSystems) {
     }
 }
 
-// One mass on a spring from a fixed point, no gravity: symplectic Euler turns
-// x'' = -w^2 x into a rotation by theta per step with cos(theta) = 1 - (w h)^2 / 2; the
-// discrete solution is x_n = A cos(n theta) + B sin(n theta). Its frequency error against
-// w is (w h)^2 / 24 to leading order.
-TEST(SingleSpring, OscillatesAsTheSchemesDiscreteSolutionAndNearTheAnalyticFrequency) {
-    const Real k = 40, m = Real(0.1), rest = 1, amplitude = Real(0.05);
-    const Real h = Real(1.0 / 240.0);
-    SpringPhase spring;
-    spring.add(0, 1, rest);
-    Matrix3X x(3, 2), v = Matrix3X::Zero(3, 2), force(3, 2);
-    x.col(0) = Vec3::Zero();
-    x.col(1) = Vec3(0, -(rest + amplitude), 0);
-    VectorX inv_mass(2);
-    inv_mass << 0, 1 / m;
-    const double w = std::sqrt(double(k / m));
-    const double theta = std::acos(1 - w * w * double(h) * double(h) / 2);
-    // Discrete solution from x_0 = A and x_1 = x_0 + h v_1 with v_1 = -h w^2 x_0.
-    const double a = amplitude;
-    const double x1 = a * (1 - w * w * double(h) * double(h));
-    const double b = (x1 - a * std::cos(theta)) / std::sin(theta);
-    int crossings = 0;
-    double first_crossing = 0, last_crossing = 0, previous = a;
-    const int steps = 2400;
-    for (int n = 1; n <= steps; ++n) {
-        force.setZero();
-        add_spring_forces(spring, k, x, force);
-        integrate_particles(x, v, inv_mass, force, 2, 1, 0, BodyMotion{}, Vec3::Zero(), h);
-        const double stretch = -double(x(1, 1)) - double(rest);
-        ASSERT_NEAR(stretch, a * std::cos(n * theta) + b * std::sin(n * theta), 2e-4 * a) << "step " << n;
-        if ((previous > 0) != (stretch > 0)) {
-            const double t = (n - 1 + previous / (previous - stretch)) * double(h);
-            if (crossings == 0) first_crossing = t;
-            last_crossing = t;
-            ++crossings;
-        }
-        previous = stretch;
+// Eq. 2's drag on a particle in still air (no body motion): v_(n+1) = v_n (1 - h k / m).
+TEST(Drag, SlowsAParticleAsTheSchemeSays) {
+    Matrix3X x = Matrix3X::Zero(3, 1), v(3, 1);
+    v.col(0) = Vec3(2, 0, -1);
+    const Real m = Real(0.01), k = Real(0.002), h = Real(1.0 / 240.0);
+    const VectorX inv_mass = VectorX::Constant(1, 1 / m), drag = VectorX::Constant(1, k);
+    const Vec3 v0 = v.col(0);
+    for (int n = 1; n <= 240; ++n) {
+        predict_particles(x, v, inv_mass, drag, 1, AnchorMotion{}, InertiaScales{}, Vec3::Zero(), h);
+        const double factor = std::pow(1 - double(h * k / m), n);
+        ASSERT_NEAR((Vec3(v.col(0)) - v0 * Real(factor)).norm(), 0, 1e-4) << "step " << n;
     }
-    ASSERT_GE(crossings, 4);
-    const double period = 2 * (last_crossing - first_crossing) / (crossings - 1);
-    const double analytic = 2 * std::numbers::pi / w;
-    const double known_error = (w * double(h)) * (w * double(h)) / 24;
-    EXPECT_NEAR(period / analytic, 1.0, 1.5 * known_error + 1e-4);
+    EXPECT_LT(drag_step_limit_s(inv_mass, drag, 1), m / k * Real(1.0001));
 }
 
-TEST(Stability, ClassicNeedsASmallerStepThanSimplifiedForTheSameMaterial) {
-    RectangleParams params;
-    const Garment g = *make_rectangle(params);
-    const Real simplified = stable_step_s(*g.fabric, g.config.material, g.state.inv_mass, ClothModel::simplified);
-    const Real classic = stable_step_s(*g.fabric, g.config.material, g.state.inv_mass, ClothModel::classic);
-    EXPECT_GT(simplified, classic);
-    // A single spring and a fixed end: the bound is the textbook 2 sqrt(m / k).
-    Fabric t;
-    t.layer = {1, 1};
-    t.layer1_count = 2;
-    t.warp1.add(0, 1, 1);
-    ClothMaterial material;
-    material.drag_N_s_m = 0;
+// A frame that accelerates and turns, and its substeps: centre and rotation at each step.
+struct MovingFrame {
+    Vec3 velocity(double t) const { return Vec3(Real(0.8 + 2.0 * t), Real(0.3 * std::sin(4 * t)), Real(-0.5)); }
+    Vec3 angular(double t) const { return Vec3(Real(0.2), Real(1.5 + std::sin(3 * t)), Real(-0.4)); }
+    // Advances (R, c) over one step of h with the velocities of the step (constant over it).
+    void advance(Mat3& r, Vec3& c, double t, double h) const {
+        c += velocity(t) * Real(h);
+        const Vec3 w = angular(t) * Real(h);
+        r = Eigen::AngleAxis<Real>(w.norm(), w.normalized()).toRotationMatrix() * r;
+    }
+};
+
+// Runs `steps` substeps of predict_particles on one free particle (no gravity, no drag)
+// carried by the moving frame with inertia scales `inertia`; returns its world position and
+// velocity, and the frame's last pose.
+struct Carried {
+    Vec3 x, v;
+    Mat3 r;
+    Vec3 c;
+};
+Carried carry(const InertiaScales& inertia, int steps, double h, const Vec3& x0, const Vec3& v0) {
+    const MovingFrame frame;
+    Matrix3X x(3, 1), v(3, 1);
+    x.col(0) = x0;
+    v.col(0) = v0;
+    const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+    Mat3 r = Mat3::Identity();
+    Vec3 c = Vec3::Zero();
+    Vec3 v_before = frame.velocity(0), w_before = frame.angular(0);
+    for (int n = 0; n < steps; ++n) {
+        const double t = n * h;
+        AnchorMotion m;
+        m.r0 = r;
+        m.c0 = c;
+        frame.advance(r, c, t, h);
+        m.r1 = r;
+        m.c1 = c;
+        m.velocity_m_s = frame.velocity(t);
+        m.angular_velocity_rad_s = frame.angular(t);
+        m.velocity_before_m_s = v_before;
+        m.angular_velocity_before_rad_s = w_before;
+        m.acceleration_m_s2 = (m.velocity_m_s - v_before) / Real(h);
+        predict_particles(x, v, inv_mass, drag, 1, m, inertia, Vec3::Zero(), Real(h));
+        v_before = m.velocity_m_s;
+        w_before = m.angular_velocity_rad_s;
+    }
+    return {x.col(0), v.col(0), r, c};
+}
+
+// Inertia scales 1 (physical): whatever the anchor does, a free particle keeps its world
+// velocity and moves in a straight line. The inertial terms (-m a_b of eq. 2, and the
+// frame's rotation) cancel the frame's motion to the scheme's order: the error halves with h.
+TEST(AnchorFrame, WithFullInertiaAFreeParticleMovesInAStraightLineWhateverTheBodyDoes) {
+    const Vec3 x0(Real(0.3), Real(-0.4), Real(0.2)), v0(Real(0.1), Real(-0.2), Real(0.05));
+    double previous = 0;
+    for (int refine : {1, 2, 4}) {
+        const double h = 1.0 / (120.0 * refine);
+        const int steps = 60 * refine;  // 0.5 s
+        const Carried p = carry(InertiaScales{}, steps, h, x0, v0);
+        const Vec3 expected = x0 + v0 * Real(steps * h);
+        const double error = (p.x - expected).norm();
+        EXPECT_LT(error, 0.02) << "h = " << h;
+        EXPECT_LT((p.v - v0).norm(), 0.1) << "h = " << h;  // from 2 rad/s and 2 m/s^2 of the body
+        if (refine > 1) {
+            EXPECT_LT(error, 0.7 * previous) << "first order: the error shrinks with the step";
+        }
+        previous = error;
+    }
+}
+
+// Inertia scales 0: a particle at rest in the anchor's frame stays where it is in that frame,
+// however the frame accelerates and turns (the garment is carried rigidly).
+TEST(AnchorFrame, WithoutInertiaAParticleAtRestInTheFrameStaysThere) {
+    const MovingFrame frame;
+    const Vec3 r0(Real(0.2), Real(-0.3), Real(0.1));
+    const Vec3 v0 = frame.velocity(0) + frame.angular(0).cross(r0);  // at rest in the frame at t = 0
+    const Carried p = carry(InertiaScales{0, 0}, 120, 1.0 / 120.0, r0, v0);
+    const Vec3 in_frame = p.r.transpose() * (p.x - p.c);
+    EXPECT_LT((in_frame - r0).norm(), 1e-4);
+}
+
+// Linear inertia s: when the anchor's velocity changes by dV within a step, the particle's
+// world velocity changes by (1 - s) dV (no rotation, no gravity, no drag).
+TEST(AnchorFrame, LinearInertiaScaleSetsHowMuchOfTheBodysJerkTheParticleFeels) {
+    for (Real s : {Real(0), Real(0.5), Real(1)}) {
+        Matrix3X x = Matrix3X::Zero(3, 1), v = Matrix3X::Zero(3, 1);
+        const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+        AnchorMotion m;
+        m.velocity_before_m_s = Vec3::Zero();
+        m.velocity_m_s = Vec3(2, 0, 0);  // a jerk: the body starts moving at 2 m/s
+        const Real h = Real(1.0 / 60.0);
+        m.c1 = m.velocity_m_s * h;
+        m.acceleration_m_s2 = m.velocity_m_s / h;
+        predict_particles(x, v, inv_mass, drag, 1, m, InertiaScales{s, 1}, Vec3::Zero(), h);
+        EXPECT_NEAR(v(0, 0), (1 - s) * 2, 1e-5) << "s = " << s;
+        EXPECT_NEAR(x(0, 0), (1 - s) * 2 * h, 1e-6) << "s = " << s;
+    }
+}
+
+// A mass hanging from a pinned end on one spring in compliance form settles where the
+// spring carries its weight: stretch m g / k, however stiff the spring and however long the
+// step (the compliance form has no stability bound, unlike the explicit spring).
+TEST(CompliantSpring, SettlesAtTheStaticStretchForAnyStiffnessAndStep) {
+    for (Real k : {Real(5), Real(500), Real(5e6)})
+        for (Real h : {Real(1.0 / 240.0), Real(1.0 / 15.0)}) {
+            SpringPhase phase;
+            phase.add(0, 1, 1);
+            SpringSet set;
+            set.springs = &phase;
+            set.strips = spring_strips(phase);
+            set.compliance = {1 / k};
+            set.lambda = {0};
+            const Real m = Real(0.1);
+            Matrix3X x(3, 2), v = Matrix3X::Zero(3, 2);
+            x.col(0) = Vec3::Zero();
+            x.col(1) = Vec3(0, -1, 0);
+            VectorX inv_mass(2);
+            inv_mass << 0, 1 / m;
+            const VectorX drag = VectorX::Constant(2, Real(0.05));  // some air: it settles
+            Matrix3XRows rows;
+            for (int n = 0; n < static_cast<int>(20 / h); ++n) {
+                const Matrix3X start = x;
+                predict_particles(x, v, inv_mass, drag, 2, AnchorMotion{}, InertiaScales{},
+                                  Vec3(0, -standard_gravity_m_s2, 0), h);
+                set.lambda[0] = 0;
+                rows = x;
+                for (int round = 0; round < 4; ++round) solve_springs(set, rows, inv_mass, h, Real(10));
+                x = rows;
+                v = (x - start) / h;
+                v.col(0).setZero();
+            }
+            const double stretch = -double(x(1, 1)) - 1;
+            const double expected = double(m) * double(standard_gravity_m_s2) / double(k);
+            ASSERT_TRUE(x.allFinite()) << "k = " << k << ", h = " << h;
+            EXPECT_NEAR(stretch, expected, 0.02 * expected + 1e-6) << "k = " << k << ", h = " << h;
+        }
+}
+
+// Provot's limit (method §4.1) holds whatever the spring: a soft spring pulled far is cut
+// back to 1 + limit times its rest length in one pass, the pinned end unmoved.
+TEST(CompliantSpring, ProvotsLimitCutsAnOverStretchedSpringBackToTheLimit) {
+    SpringPhase phase;
+    phase.add(0, 1, 1);
+    SpringSet set;
+    set.springs = &phase;
+    set.strips = spring_strips(phase);
+    set.compliance = {Real(1e30)};  // no force: the limit alone
+    set.lambda = {0};
+    Matrix3XRows x(3, 2);
+    x.col(0) = Vec3::Zero();
+    x.col(1) = Vec3(0, -3, 0);
     VectorX inv_mass(2);
-    inv_mass << 0, 4;  // m = 0.25 kg
-    EXPECT_NEAR(stable_step_s(t, material, inv_mass, ClothModel::classic), 2 * std::sqrt(0.25 / material.stretch_k_N_m),
-                1e-5);
+    inv_mass << 0, 10;
+    solve_springs(set, x, inv_mass, Real(1.0 / 60.0), Real(0.1));
+    EXPECT_EQ(Vec3(x.col(0)), Vec3::Zero());
+    EXPECT_NEAR((x.col(1) - x.col(0)).norm(), 1.1, 1e-5);
+}
+
+// Strips (constraints.hpp): runs of springs whose ends are consecutive particles are found,
+// a chain is split so that no two springs of a strip share a particle, and every spring is
+// in exactly one strip.
+TEST(SpringStrips, CoverEverySpringOnceAndNoStripSharesAParticle) {
+    SpringPhase phase;
+    for (std::uint32_t i = 0; i < 9; ++i) phase.add(i, i + 1, 1);         // a chain
+    for (std::uint32_t i = 0; i < 10; ++i) phase.add(20 + i, 40 + i, 1);  // a row between two lines
+    for (std::uint32_t i = 0; i < 12; ++i) phase.add(60 + i, 63 + i, 1);  // rows three apart
+    phase.add(5, 77, 1);                                                   // a stray one
+    const auto strips = spring_strips(phase);
+    std::vector<int> seen(phase.size(), 0);
+    for (const SpringStrip& st : strips) {
+        std::vector<std::uint32_t> particles;
+        for (std::uint32_t k = 0; k < st.count; ++k) {
+            const std::uint32_t s = st.first + k * st.stride;
+            ASSERT_LT(s, phase.size());
+            ++seen[s];
+            EXPECT_EQ(phase.a[s], st.a + k * st.stride);
+            EXPECT_EQ(phase.b[s], st.b + k * st.stride);
+            particles.push_back(phase.a[s]);
+            particles.push_back(phase.b[s]);
+        }
+        std::sort(particles.begin(), particles.end());
+        EXPECT_EQ(std::adjacent_find(particles.begin(), particles.end()), particles.end()) << "a strip shares a particle";
+    }
+    for (std::size_t s = 0; s < seen.size(); ++s) EXPECT_EQ(seen[s], 1) << "spring " << s;
 }
 
 }  // namespace

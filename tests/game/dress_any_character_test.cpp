@@ -8,7 +8,7 @@
 
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
-#include "game/scene.hpp"
+#include "game/world.hpp"
 
 namespace drape {
 namespace {

@@ -11,7 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
+#include "game/world.hpp"
 #include "game/video.hpp"
 #include "tests/character/test_character_file.hpp"
 
@@ -133,7 +134,7 @@ TEST_F(PlayCommand, ASceneThatFailsWhileBuildingLeavesNoFolderBehind) {
     if (!render_available()) GTEST_SKIP() << "built without the render module (--out is refused up front there)";
     // Read and checked fine, but no collider crosses a waist 10 m up: fails in build_world.
     std::ofstream(m_dir / "tall_waist.json") << R"({"characters": [{"file": ")" << default_avatar_path().string()
-                                             << R"("}], "garments": [{"type": "skirt", "waist_height_m": 9.99}]})";
+                                             << R"("}], "garments": [{"type": "skirt", "ring_height_m": 9.99}]})";
     for (const std::string args : {"--out new/frames", "", "--video clip.mp4"}) {
         const PlayRun run = play("--scene tall_waist.json --frames 2 --size 64x48 " + args, m_dir);
         EXPECT_EQ(run.status, 1) << args;

@@ -10,6 +10,7 @@
 
 #include "components/garment.hpp"
 #include "game/stats.hpp"
+#include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
 namespace {
@@ -39,14 +40,19 @@ RunStats example() {
     s.name = "render";
     s.mean_ms = std::numeric_limits<double>::quiet_NaN();  // must not produce invalid JSON
     r.systems.push_back(s);
-    r.garments.push_back({.particles = 837, .max_strain = 0.1, .max_penetration_m = 0.004, .nonfinite = 0,
-                          .collision_tests_per_frame = 1234.5});
+    r.characters.push_back({.file = "assets/avatar.glb", .clip = "Walk", .height_m = 1.75});
+    r.garments.push_back({.particles = 837, .strain_max = 0.1, .strain_p99 = 0.05, .penetration_after_frame_m = 0.0001,
+                          .penetration_before_response_m = 0.004, .pins_inside_m = 0.002, .rise_above_pins_m = 0.01,
+                          .nonfinite = 0, .resets = 1, .collision_tests_per_frame = 1234.5});
     return r;
 }
 
 TEST(StatsFile, HasExactlyTheDocumentedFields) {
     const nlohmann::json j = nlohmann::json::parse(stats_json(example()));
-    EXPECT_EQ(keys(j), (std::vector<std::string>{"frames", "garments", "sim_dt_s", "systems"}));
+    EXPECT_EQ(keys(j), (std::vector<std::string>{"characters", "frames", "garments", "sim_dt_s", "systems"}));
+    ASSERT_EQ(j["characters"].size(), 1u);
+    EXPECT_EQ(keys(j["characters"][0]), (std::vector<std::string>{"clip", "file", "height_m"}));
+    EXPECT_EQ(j["characters"][0]["clip"], "Walk");
     EXPECT_EQ(j["frames"], 240);
     EXPECT_DOUBLE_EQ(j["sim_dt_s"].get<double>(), 1.0 / 60.0);
     ASSERT_TRUE(j["systems"].is_object());
@@ -61,7 +67,13 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     ASSERT_EQ(j["garments"].size(), 1u);
     const auto& g = j["garments"][0];
     EXPECT_EQ(keys(g), (std::vector<std::string>{"collision_tests_per_frame", "max_penetration_m", "max_strain", "nonfinite",
-                                                 "particles"}));
+                                                 "particles", "penetration_m", "pins_inside_m", "resets", "rise_above_pins_m",
+                                                 "strain"}));
+    EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99"}));
+    EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max"}));
+    EXPECT_DOUBLE_EQ(g["strain"]["p99"].get<double>(), 0.05);
+    EXPECT_DOUBLE_EQ(g["penetration_m"]["before_response_max"].get<double>(), 0.004);
+    EXPECT_EQ(g["resets"], 1);
     EXPECT_EQ(g["particles"], 837);
     EXPECT_DOUBLE_EQ(g["collision_tests_per_frame"].get<double>(), 1234.5);
 }
@@ -86,30 +98,55 @@ TEST(StatsFile, IsWrittenWholeOrNotAtAll) {
     fs::remove_all(dir);
 }
 
-TEST(GarmentWatch, ReportsWorstValuesAndNonFiniteParticles) {
+TEST(GarmentWatch, ReportsWorstValuesAfterEachFrameAndNonFiniteParticles) {
     Registry registry;
-    const Entity e = registry.create();
-    Garment& g = registry.emplace<Garment>(e);
-    g.state.x = Matrix3X::Zero(3, 4);
-    g.state.v = Matrix3X::Zero(3, 4);
+    RectangleParams params;
+    params.warp_lines = 4;
+    params.particles_per_line = 4;
+    const Entity e = *attach_rectangle(registry, params);
+    Garment& g = registry.get<Garment>(e);
     g.counters.collision_tests = 100;  // before the run: not counted
     GarmentWatch watch(registry, {e});
 
-    g.counters.max_strain = 0.05f;
+    // Frame 1: the hem row 20 % longer along the warp than at rest; the collision found a 1 cm push.
+    const Fabric& t = *g.fabric;
+    const std::uint32_t hem = t.grid[3], above = t.grid[2];  // line 0, rows 3 and 2
+    const Real rest = (g.state.x.col(hem) - g.state.x.col(above)).norm();
+    g.state.x.col(hem) = g.state.x.col(above) + (g.state.x.col(hem) - g.state.x.col(above)) * Real(1.2);
     g.counters.max_penetration_m = 0.01f;
     watch.sample(registry);
-    registry.get<Garment>(e).counters.collision_tests = 400;
-    registry.get<Garment>(e).counters.max_strain = 0.02f;
-    registry.get<Garment>(e).state.x(1, 2) = std::numeric_limits<Real>::quiet_NaN();
+    // Frame 2: back to rest, fewer found, a NaN.
+    g.state.x.col(hem) = g.state.x.col(above) + (g.state.x.col(hem) - g.state.x.col(above)).normalized() * rest;
+    g.counters.collision_tests = 400;
+    g.counters.max_penetration_m = 0.002f;
+    g.state.x(1, t.grid[5]) = std::numeric_limits<Real>::quiet_NaN();
     watch.sample(registry);
 
     const auto result = watch.result(registry);
     ASSERT_EQ(result.size(), 1u);
-    EXPECT_EQ(result[0].particles, 4u);
-    EXPECT_FLOAT_EQ(static_cast<float>(result[0].max_strain), 0.05f);
-    EXPECT_FLOAT_EQ(static_cast<float>(result[0].max_penetration_m), 0.01f);
+    EXPECT_EQ(result[0].particles, 16u);
+    EXPECT_FALSE(std::isfinite(result[0].strain_max));  // a NaN spring is reported, not hidden
+    EXPECT_NEAR(result[0].penetration_before_response_m, 0.01, 1e-6);
     EXPECT_EQ(result[0].nonfinite, 1u);
     EXPECT_DOUBLE_EQ(result[0].collision_tests_per_frame, 150.0);  // (400 - 100) tests over 2 frames
+}
+
+TEST(GarmentWatch, StrainIsMeasuredOnTheGarmentAfterTheFrame) {
+    Registry registry;
+    RectangleParams params;
+    params.warp_lines = 4;
+    params.particles_per_line = 4;
+    const Entity e = *attach_rectangle(registry, params);
+    Garment& g = registry.get<Garment>(e);
+    GarmentWatch watch(registry, {e});
+    const Fabric& t = *g.fabric;
+    const std::uint32_t hem = t.grid[3], above = t.grid[2];
+    g.state.x.col(hem) = g.state.x.col(above) + (g.state.x.col(hem) - g.state.x.col(above)) * Real(1.2);
+    watch.sample(registry);
+    const auto result = watch.result(registry);
+    EXPECT_NEAR(result[0].strain_max, 0.2, 1e-4);
+    EXPECT_GT(result[0].strain_p99, 0.0);  // the histogram saw the stretched springs
+    EXPECT_EQ(result[0].pins_inside_m, 0.0);
 }
 
 }  // namespace

@@ -10,7 +10,8 @@
 #include "components/garment.hpp"
 #include "components/skinned_mesh.hpp"
 #include "engine/render/renderer.hpp"
-#include "game/scene.hpp"
+#include "game/sample_scene.hpp"
+#include "game/world.hpp"
 
 namespace drape {
 namespace {

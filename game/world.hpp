@@ -2,13 +2,13 @@
 // entities of the scene, and optionally a Renderer. Used by `drape play`, the tests and
 // the benchmarks, so that all three run exactly the same scene.
 //
-//   auto scene = drape::sample_scene();                      // or load_scene_file("x.json")
-//   auto world = drape::build_world(*scene, {});             // headless
+//   auto scene = drape::load_scene_file("x.json");        // or drape::sample_scene()
+//   auto world = drape::build_world(*scene, {});           // headless
 //   for (int i = 0; i < 600; ++i) drape::step_world(*world, 1.0 / 60.0);
 //
 // Systems, in phase order (engine/core/scheduler.hpp): the character systems (animation,
-// skinning, colliders), then `teleport_guard`, then the cloth systems, then (when
-// rendering) the render system.
+// skinning, colliders), then the teleport guard (systems/teleport_guard_system.hpp), then
+// the cloth systems, then (when rendering) the render system.
 //
 // Robustness (method-independent, docs/scenes.md "solver"):
 // - hitches: step_world clamps a frame time to `solver.max_frame_dt_s` before the
@@ -28,8 +28,9 @@
 #include "engine/core/error.hpp"
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
-#include "game/scene_file.hpp"
+#include "game/scene_description.hpp"
 #include "game/stats.hpp"
+#include "systems/teleport_guard_system.hpp"
 
 namespace drape {
 
@@ -43,12 +44,8 @@ struct WorldOptions {
     bool profile = true;             ///< Time every system run (the frame budget table).
 };
 
-/// Counts of what the teleport guard did.
-struct TeleportLog {
-    std::uint64_t teleports = 0;     ///< Jumps detected.
-    std::uint64_t resets = 0;        ///< Garments reset because of them (or on request).
-};
-
+/// A running scene: its description, registry, scheduler with the systems, its entities,
+/// and the renderer when it renders.
 struct World {
     SceneDescription scene;
     Registry registry;
@@ -85,17 +82,6 @@ void set_garment_model(World& world, ClothModel model);
 
 /// True when a garment particle, velocity or body vertex is not finite.
 [[nodiscard]] bool has_nonfinite(const World& world);
-
-/// The project's asset folder: $DRAPE_ASSETS, ./assets, next to the executable
-/// (../assets, ../share/drape/assets) or the source tree's assets/.
-[[nodiscard]] std::filesystem::path asset_dir();
-
-/// The default avatar file (assets/avatar.glb).
-[[nodiscard]] std::filesystem::path default_avatar_path();
-
-/// The sample scene: the default avatar walking in place in a skirt. The same as
-/// assets/scenes/sample.json.
-[[nodiscard]] SceneDescription sample_scene();
 
 /// Whether this build has the render module.
 [[nodiscard]] bool render_available() noexcept;

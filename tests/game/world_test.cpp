@@ -11,7 +11,11 @@
 #include "components/garment.hpp"
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
-#include "game/scene.hpp"
+#include "game/asset_paths.hpp"
+#include "game/sample_scene.hpp"
+#include "game/scene_file.hpp"
+#include "game/world.hpp"
+#include "game/scene_garment_parameters.hpp"
 #include "systems/cloth/garment_builder.hpp"
 
 namespace drape {
@@ -215,16 +219,16 @@ TEST(BuildWorld, BadScenesNameTheField) {
 
 TEST(ParticleLimit, OneLimitForScenesAndCppBuilders) {
     // A C++ builder refuses an absurd grid with the fields and the limit...
-    SkirtParams skirt;
+    TubeParams skirt = TubeParams::skirt();
     skirt.warp_lines = 1002;
     skirt.particles_per_line = 1000;
-    auto r = validate(skirt);
+    auto r = validate(skirt, "skirt");
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().message, "skirt.warp_lines x skirt.particles_per_line: must be at most 250000 particles, got 1002 x 1000 = 1002000");
-    DressParams dress;
+    TubeParams dress = TubeParams::dress();
     dress.warp_lines = 501;
     dress.particles_per_line = 500;
-    EXPECT_FALSE(validate(dress));
+    EXPECT_FALSE(validate(dress, "dress"));
     // ... and a scene asking for the most particles gets a garment within the same limit
     // (the grid's rounding may not pass it).
     SceneDescription scene = sample();
@@ -293,17 +297,19 @@ TEST(BuildWorld, RandomGarmentParametersGiveAWorldOrOneError) {
         GarmentDescription& g = scene.garments[0];
         g.type = (i % 4 == 3) ? GarmentType::dress : GarmentType::skirt;
         g.model = (i % 2) ? ClothModel::classic : ClothModel::simplified;
-        for (const GarmentParameterSpec& spec : garment_parameters(g.type)) {
+        for (const ParameterSpec* spec : scene_garment_parameters()) {
             if (rng() % 3 != 0) continue;
-            if (spec.name == "particles" || spec.name == "warp_lines" || spec.name == "particles_per_line") {
-                if (spec.name == "particles") g.parameters.push_back({"particles", double(100 + rng() % 1500)});
+            if (spec->name == "particles" || spec->name == "warp_lines" || spec->name == "particles_per_line") {
+                if (spec->name == "particles") g.parameters.push_back({"particles", double(100 + rng() % 1500)});
                 continue;  // keep each case small
             }
-            std::uniform_real_distribution<double> u(spec.min, std::min(spec.max, spec.min + 10.0));
+            const ParameterRange& range = spec->range;
+            std::uniform_real_distribution<double> u(range.min, std::min(range.max, range.min + 10.0));
             double v = u(rng);
-            if (spec.integer) v = std::round(v);
-            if (spec.min_exclusive && v <= spec.min) v = spec.min + 0.01;
-            g.parameters.push_back({std::string(spec.name), v});
+            if (spec->kind == ParameterKind::integer) v = std::round(v);
+            if (range.min_open && v <= range.min) v = range.min + 0.01;
+            if (range.max_open && v >= range.max) v = range.max - 0.01;
+            g.parameters.push_back({std::string(spec->name), v});
         }
         auto world = build_world(scene, {});
         if (!world) {

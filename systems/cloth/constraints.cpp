@@ -1,0 +1,160 @@
+// Constraints in compliance form; step order in constraints.hpp.
+#include "systems/cloth/constraints.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace drape {
+
+std::vector<Real> spring_compliance(const SpringPhase& springs, const VectorX& area, Real modulus) {
+    std::vector<Real> c(springs.size());
+    for (std::size_t s = 0; s < springs.size(); ++s) {
+        const Real rest = springs.rest_m[s];
+        const Real k = modulus * (area[springs.a[s]] + area[springs.b[s]]) / (2 * rest * rest);
+        c[s] = k > Real(1e-30) ? std::min(Real(1e30), 1 / k) : Real(1e30);
+    }
+    return c;
+}
+
+std::vector<SpringStrip> spring_strips(const SpringPhase& sp) {
+    std::vector<SpringStrip> strips;
+    const std::uint32_t n = static_cast<std::uint32_t>(sp.size());
+    std::uint32_t s = 0;
+    while (s < n) {
+        // The longest run from s of consecutive ends.
+        std::uint32_t len = 1;
+        while (s + len < n && sp.a[s + len] == sp.a[s] + len && sp.b[s + len] == sp.b[s] + len) ++len;
+        const std::uint32_t a = sp.a[s], b = sp.b[s];
+        const std::uint32_t gap = a > b ? a - b : b - a;
+        if (gap >= len) {
+            strips.push_back({a, b, s, len, 1});  // the two ends' ranges do not meet
+        } else if (gap == 1) {
+            // A chain: its even springs, then its odd ones.
+            strips.push_back({a, b, s, (len + 1) / 2, 2});
+            if (len > 1) strips.push_back({a + 1, b + 1, s + 1, len / 2, 2});
+        } else {
+            // Blocks of `gap` springs are independent; one after the other, in order (a warp
+            // phase: row after row from the fitting zone down, as Gauss-Seidel hangs a line).
+            for (std::uint32_t k = 0; k < len; k += gap) strips.push_back({a + k, b + k, s + k, std::min(gap, len - k), 1});
+        }
+        s += len;
+    }
+    return strips;
+}
+
+namespace {
+
+// One strip (constraints.hpp step 3): XPBD, then Provot's limit, every spring in its own
+// vector lane. Pointers are the strip's first entries; `Stride` its stride. The a and b
+// entries of a strip are distinct particles (spring_strips), so nothing aliases.
+template <int Stride>
+void solve_strip(int count, Real* __restrict a0, Real* __restrict a1, Real* __restrict a2, Real* __restrict b0,
+                 Real* __restrict b1, Real* __restrict b2, const Real* __restrict wa_, const Real* __restrict wb_,
+                 const Real* __restrict rest, const Real* __restrict compliance, Real* __restrict lambda, Real inv_h2,
+                 Real limit_scale) {
+#pragma GCC ivdep
+    for (int k = 0; k < count; ++k) {
+        const int i = k * Stride;
+        const Real d0 = b0[i] - a0[i], d1 = b1[i] - a1[i], d2 = b2[i] - a2[i];
+        const Real length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+        const Real wa = wa_[i], wb = wb_[i], wsum = wa + wb;
+        const Real r = rest[i];
+        // XPBD: dlambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~), C = length - rest.
+        const Real alpha = compliance[i] * inv_h2;
+        const Real lam = lambda[i];
+        Real dl = (r - length - alpha * lam) / (wsum + alpha);
+        lambda[i] = lam + dl;
+        // Provot: whatever is left beyond the limit goes entirely.
+        const Real over = length + dl * wsum - limit_scale * r;
+        const Real excess = over > 0 ? over : Real(0);
+        dl -= excess / (wsum + Real(1e-30));
+        const Real scale = dl / (length + Real(1e-30));  // coincident ends: no direction, no move
+        const Real m0 = scale * d0, m1 = scale * d1, m2 = scale * d2;
+        a0[i] -= wa * m0;
+        a1[i] -= wa * m1;
+        a2[i] -= wa * m2;
+        b0[i] += wb * m0;
+        b1[i] += wb * m1;
+        b2[i] += wb * m2;
+    }
+}
+
+}  // namespace
+
+void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& w, Real h, Real limit) {
+    Real* x0 = x.row(0).data();
+    Real* x1 = x.row(1).data();
+    Real* x2 = x.row(2).data();
+    const Real inv_h2 = 1 / (h * h);
+    const Real limit_scale = set.limited ? 1 + limit : std::numeric_limits<Real>::infinity();
+    const Real* rest = set.springs->rest_m.data();
+    const Real* compliance = set.compliance.data();
+    Real* lambda = set.lambda.data();
+    const Real* wp = w.data();
+    for (const SpringStrip& st : set.strips) {
+        const int count = static_cast<int>(st.count);
+        const std::uint32_t a = st.a, b = st.b, f = st.first;
+        if (st.stride == 1)
+            solve_strip<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, wp + a, wp + b, rest + f, compliance + f,
+                           lambda + f, inv_h2, limit_scale);
+        else
+            solve_strip<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, wp + a, wp + b, rest + f, compliance + f,
+                           lambda + f, inv_h2, limit_scale);
+    }
+}
+
+Tethers build_tethers(const Fabric& f, const VectorX& w, std::uint32_t count) {
+    Tethers t;
+    const std::uint32_t m = f.particles_per_line;
+    // Rest lengths along each line from the warp springs (listed line by line, pins outward).
+    std::vector<Real> down(f.particle_count(), 0);  // rest length of the spring above each particle
+    for (const SpringPhase* phase : {&f.warp1, &f.warp2})
+        for (std::size_t s = 0; s < phase->size(); ++s) down[phase->b[s]] = phase->rest_m[s];
+    for (std::uint32_t line = 0; line < f.warp_lines; ++line) {
+        std::uint32_t anchor = std::numeric_limits<std::uint32_t>::max();
+        Real along = 0;
+        for (std::uint32_t row = 0; row < m; ++row) {
+            const std::uint32_t p = f.grid[line * m + row];
+            if (w[p] == 0) {
+                anchor = p;
+                along = 0;
+                continue;
+            }
+            along += down[p];
+            if (anchor == std::numeric_limits<std::uint32_t>::max() || p >= count) continue;
+            t.particle.push_back(p);
+            t.anchor.push_back(anchor);
+            t.length_m.push_back(along);
+        }
+    }
+    return t;
+}
+
+void solve_tethers(const Tethers& t, Matrix3XRows& x) {
+    Real* x0 = x.row(0).data();
+    Real* x1 = x.row(1).data();
+    Real* x2 = x.row(2).data();
+    for (std::size_t k = 0; k < t.particle.size(); ++k) {
+        const std::uint32_t p = t.particle[k], q = t.anchor[k];
+        const Real d0 = x0[p] - x0[q], d1 = x1[p] - x1[q], d2 = x2[p] - x2[q];
+        const Real max_length = t.length_m[k];
+        const Real length_sq = d0 * d0 + d1 * d1 + d2 * d2;
+        if (length_sq <= max_length * max_length) continue;
+        const Real scale = max_length / std::sqrt(length_sq);
+        x0[p] = x0[q] + d0 * scale;
+        x1[p] = x1[q] + d1 * scale;
+        x2[p] = x2[q] + d2 * scale;
+    }
+}
+
+Real max_strain(const SpringPhase& springs, const Matrix3X& x) {
+    Real worst_sq = 0;
+    for (std::size_t s = 0; s < springs.size(); ++s) {
+        const Real ratio_sq = (x.col(springs.b[s]) - x.col(springs.a[s])).squaredNorm() / (springs.rest_m[s] * springs.rest_m[s]);
+        worst_sq = std::max(worst_sq, ratio_sq);
+    }
+    return worst_sq > 1 ? std::sqrt(worst_sq) - 1 : Real(0);
+}
+
+}  // namespace drape

@@ -1,0 +1,75 @@
+// The garment's constraints in compliance form (method §3.3 springs, §4.1 Provot's limit),
+// solved by Gauss-Seidel rounds after the explicit prediction of integrator.hpp.
+//
+// Step order of one round (cloth constraint system; docs/cloth.md "Solver"):
+//   1. Tethers: a free particle no farther from the pinned particle at the top of its warp
+//      line than the rest length of the line between them (long-range attachments, as Jolt
+//      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
+//      line's weight up to its pin, the tether does it in one).
+//   2. Springs, set by set in list order (warp springs run from the pins outward): the
+//      stretch spring of stiffness k as an XPBD constraint of compliance 1/k (the implicit
+//      response of the same Hooke spring, stable at any stiffness), then Provot's limit: a
+//      spring still longer than (1 + limit) x rest has its ends moved back to the limit,
+//      shared by inverse mass (a pinned end stays).
+// Positions only: the velocities follow from the whole substep's move afterwards
+// (garment_step.hpp), as Provot's velocities follow his corrections.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "components/garment.hpp"
+#include "engine/core/math.hpp"
+
+namespace drape {
+
+/// A run of `count` springs whose ends are consecutive particles: spring `first + k stride`
+/// joins particles `a + k stride` and `b + k stride`, and no two springs of the run share a
+/// particle, so the run is solved in vector lanes, each spring as if alone.
+struct SpringStrip {
+    std::uint32_t a = 0, b = 0, first = 0, count = 0;
+    std::uint32_t stride = 1;
+};
+
+/// The strips of a phase in solving order. Springs listed in particle order (garment
+/// builders) make long strips: a row of warp springs is a strip, solved row after row from
+/// the fitting zone down; a chain of springs sharing ends is solved as its even springs,
+/// then its odd ones; springs that fit no run become strips of one.
+[[nodiscard]] std::vector<SpringStrip> spring_strips(const SpringPhase& springs);
+
+/// Springs of one phase as the solver sees them.
+struct SpringSet {
+    const SpringPhase* springs = nullptr;
+    std::vector<SpringStrip> strips;
+    std::vector<Real> compliance;  ///< Per spring: 1 / k, m/N (1e30: a spring without force).
+    std::vector<Real> lambda;      ///< Per spring: XPBD multiplier of the current substep.
+    bool limited = true;           ///< Provot's limit applies (structural springs).
+};
+
+/// Per spring: 1 / k with k = modulus x (area_a + area_b) / (2 rest^2) (components/garment.hpp).
+/// `area` per particle; a modulus of 0 gives a spring without force (limit only).
+[[nodiscard]] std::vector<Real> spring_compliance(const SpringPhase& springs, const VectorX& area, Real modulus_N_m);
+
+/// One Gauss-Seidel round over `set` (step 2) in a substep of h_s, strip by strip, on positions
+/// held one row per coordinate. `inv_mass` 0 = does not move.
+void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
+
+/// Long-range attachments (step 1): one per free particle below a pinned one on its line.
+struct Tethers {
+    std::vector<std::uint32_t> particle;  ///< The free particle.
+    std::vector<std::uint32_t> anchor;    ///< The pinned particle above it on its warp line.
+    std::vector<Real> length_m;           ///< Rest length of the line between them.
+};
+
+/// Tethers of the free particles among [0, count) (the integrated ones), from the nearest
+/// pinned particle above each on its warp line; none for a line without a pinned particle.
+[[nodiscard]] Tethers build_tethers(const Fabric& fabric, const VectorX& inv_mass, std::uint32_t count);
+
+/// One pass over the tethers (step 1).
+void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
+
+/// Largest length / rest - 1 over `springs` (0 when none is stretched).
+[[nodiscard]] Real max_strain(const SpringPhase& springs, const Matrix3X& x);
+
+}  // namespace drape

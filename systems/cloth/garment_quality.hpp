@@ -1,0 +1,62 @@
+// What a user sees of a garment after a whole frame, measured (the quality contract of
+// docs/cloth.md): strain of the structural springs, particles left inside the body, pinned
+// particles inside the colliders, particles flung above the pins, non-finite values.
+//
+// Conventions
+// - Strain of a spring: length / rest - 1 (compression counts as 0), over every structural
+//   spring (warp of both layers, weft) with at least one free end: between two pinned
+//   particles the skin decides.
+// - Depth inside an ellipsoid: how far the centre-line response would move the particle out
+//   (collision.hpp penetration_depth), an upper bound of its distance to the surface.
+// - Rise above the pins: the largest height of a free particle above the highest pinned
+//   particle, along world up (+Y); 0 when none is higher.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "components/garment.hpp"
+#include "engine/core/registry.hpp"
+#include "systems/cloth/garment_solver.hpp"
+
+namespace drape {
+
+/// One garment after one frame.
+struct GarmentQuality {
+    Real strain_max = 0;            ///< Largest strain of a spring with a free end.
+    Real strain_p99 = 0;            ///< Its 99th percentile over those springs.
+    Real penetration_m = 0;         ///< Deepest free particle inside an ellipsoid.
+    Real pins_inside_m = 0;         ///< Deepest pinned particle inside an ellipsoid.
+    Real rise_above_pins_m = 0;     ///< See the conventions above.
+    std::uint64_t nonfinite = 0;    ///< Non-finite coordinates in x and v.
+    std::uint64_t springs = 0;      ///< Springs measured.
+};
+
+/// Strain histogram over many frames, for percentiles of a whole run (bins of 0.1 %).
+class StrainHistogram {
+public:
+    static constexpr Real bin = Real(0.001);
+    static constexpr std::size_t bins = 4000;  ///< Up to 400 %; beyond, the last bin.
+    void add(Real strain) noexcept;
+    /// Strain below which a share `q` of the samples lie (upper edge of the bin).
+    [[nodiscard]] Real percentile(double q) const noexcept;
+    [[nodiscard]] std::uint64_t samples() const noexcept { return m_samples; }
+
+private:
+    std::array<std::uint64_t, bins> m_counts{};
+    std::uint64_t m_samples = 0;
+};
+
+/// Measures `garment` against `frames` (the colliders as the cloth sees them, e.g. the
+/// solver's frames at the end of the step). When `histogram` is given, every measured
+/// spring's strain is added to it.
+[[nodiscard]] GarmentQuality measure_garment(const Garment& garment, std::span<const EllipsoidFrame> frames,
+                                             StrainHistogram* histogram = nullptr);
+
+/// The same with the colliders read from the registry at their current pose.
+[[nodiscard]] GarmentQuality measure_garment(const Registry& registry, const Garment& garment,
+                                             StrainHistogram* histogram = nullptr);
+
+}  // namespace drape
