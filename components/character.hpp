@@ -14,7 +14,7 @@ struct CharacterAsset;  // engine/assets/character_asset.hpp: what the importer 
 struct Character {
     std::string name;
     std::shared_ptr<const CharacterAsset> asset;
-    Real height_m = 0;   ///< Standing height after import normalisation.
+    Real height_m = 0;   ///< Standing height of the body (BodyLandmarks::height_m; without landmarks, the file's rest pose).
 };
 
 }  // namespace drape

@@ -1,6 +1,8 @@
 // Fitting a character's body: see character_body.hpp.
 #include "systems/character/character_body.hpp"
 
+#include "systems/character/body_landmarks.hpp"
+
 namespace drape {
 
 Result<CharacterBody> fit_character_body(const CharacterAsset& character, const FitOptions& options) {
@@ -9,7 +11,9 @@ Result<CharacterBody> fit_character_body(const CharacterAsset& character, const 
     if (!character.skeleton || !character.mesh) return fail(at + "no skeleton or mesh to fit a body to");
     CharacterBody body;
     body.hip_bone = find_hip_bone(*character.skeleton);
-    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips, character.meshes);
+    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips);
+    if (auto landmarks = find_body_landmarks(character)) body.landmarks = std::move(*landmarks);
+    else body.landmarks_error = landmarks.error().message;
     return body;
 }
 

@@ -5,8 +5,11 @@
 // every instance of that character with it (spawn.hpp).
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
+#include "components/body_landmarks.hpp"
 #include "components/ellipsoid_collider.hpp"
 #include "engine/assets/character_asset.hpp"
 #include "engine/core/error.hpp"
@@ -18,10 +21,12 @@ namespace drape {
 struct CharacterBody {
     std::vector<EllipsoidShape> ellipsoids;  ///< Fitted, bone space: bone, center, rotation, radii_m.
     int hip_bone = -1;                       ///< find_hip_bone(); -1 when none.
+    std::optional<BodyLandmarks> landmarks;  ///< find_body_landmarks(); none for a body that is not a humanoid.
+    std::string landmarks_error;             ///< Why there are none.
 };
 
-/// Fits the body of an imported character: find_hip_bone() on its skeleton and
-/// fit_ellipsoids() on its bind mesh, rest height and clips. The error (bad options, no
+/// Fits the body of an imported character: find_hip_bone() on its skeleton,
+/// fit_ellipsoids() on its bind mesh, rest height and clips, and find_body_landmarks(). The error (bad options, no
 /// skeleton or mesh) names the character's file and the field.
 [[nodiscard]] Result<CharacterBody> fit_character_body(const CharacterAsset& character, const FitOptions& options = {});
 

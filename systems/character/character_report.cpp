@@ -27,7 +27,7 @@ CoverageReport rest_pose_coverage(const CharacterAsset& c, const CharacterBody& 
     skinning_matrices(*c.skeleton, global, skinning);
     Matrix3X positions, normals;
     skin_mesh(*c.mesh, skinning, Affine3::Identity(), positions, normals);
-    return measure_coverage(body.ellipsoids, global, positions, normals, c.mesh->indices, tolerance_m);
+    return measure_coverage(body.ellipsoids, global, positions, normals, tolerance_m);
 }
 
 std::string character_report_text(const CharacterAsset& c, const CharacterBody& body, const CoverageReport& r) {
@@ -42,6 +42,20 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
                       c.meshes[i].rigid ? "  (rigid, bound to its bone)" : "");
     out += format("  bones       %zu in the skeleton, %d move vertices; hips: %s\n", s.size(), c.skin_bones,
                   body.hip_bone >= 0 ? s.bone_names[std::size_t(body.hip_bone)].c_str() : "none found");
+    if (const auto& l = body.landmarks) {
+        auto bone = [&](int b) { return b >= 0 ? s.bone_names[std::size_t(b)].c_str() : "-"; };
+        out += format("  body        %.3f m tall (floor %.3f, top %.3f); pelvis %s (by %s), chest %s, head %s\n", double(l->height_m),
+                      double(l->floor_m), double(l->top_m), bone(l->pelvis_bone), l->found_by.c_str(), bone(l->chest_bone),
+                      bone(l->head_bone));
+        out += format("  landmarks   crotch %.3f m, waist %.3f m (girth %.3f m), hips %.3f m (girth %.3f m), chest %.3f m (girth %.3f m), "
+                      "under the arms %.3f m\n",
+                      double(l->crotch_m), double(l->waist.center.rest_m.y()), double(l->waist.girth_m), double(l->hips.center.rest_m.y()),
+                      double(l->hips.girth_m), double(l->chest.center.rest_m.y()), double(l->chest.girth_m), double(l->underarm_m));
+        out += format("  limbs       legs %s, %s; arms %s, %s (left, right)\n", bone(l->left_leg.root), bone(l->right_leg.root),
+                      bone(l->left_arm.root), bone(l->right_arm.root));
+    } else {
+        out += "  body        no landmarks: " + body.landmarks_error + "\n";
+    }
     out += format("  clips       %zu\n", c.clips.size());
     for (std::size_t i = 0; i < c.clips.size(); ++i) {
         const AnimationClip& clip = *c.clips[i];
@@ -58,8 +72,7 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
     }
     out += format("  coverage    %.1f %% of %zu vertices inside or within %.0f mm (largest gap %.3f m)\n", 100 * r.coverage,
                   r.vertices, 1000 * r.tolerance_m, r.max_gap_m);
-    out += format("  bulge       %.0f %% of the ellipsoids' outer surface stands out of the skin: mean %.3f m, p95 %.3f m, max %.3f m\n",
-                  100 * r.outside_share, r.mean_bulge_m, r.p95_bulge_m, r.max_bulge_m);
+    out += format("  bulge       mean %.3f m, p95 %.3f m, max %.3f m out of the body\n", r.mean_bulge_m, r.p95_bulge_m, r.max_bulge_m);
     return out;
 }
 
@@ -81,6 +94,22 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
     j["bones"] = s.size();
     j["skin_bones"] = c.skin_bones;
     j["hip_bone"] = body.hip_bone >= 0 ? json(s.bone_names[std::size_t(body.hip_bone)]) : json(nullptr);
+    if (const auto& l = body.landmarks) {
+        auto bone = [&](int b) { return b >= 0 ? json(s.bone_names[std::size_t(b)]) : json(nullptr); };
+        auto section = [](const BodySection& x) {
+            return json{{"height_m", x.center.rest_m.y()}, {"girth_m", x.girth_m}, {"half_width_m", x.half_width_m},
+                        {"half_depth_m", x.half_depth_m}};
+        };
+        j["landmarks"] = {{"height_m", l->height_m}, {"floor_m", l->floor_m}, {"top_m", l->top_m},
+                          {"pelvis", bone(l->pelvis_bone)}, {"found_by", l->found_by}, {"chest_bone", bone(l->chest_bone)},
+                          {"head", bone(l->head_bone)}, {"crotch_m", l->crotch_m}, {"underarm_m", l->underarm_m},
+                          {"waist", section(l->waist)}, {"hips", section(l->hips)}, {"chest", section(l->chest)},
+                          {"legs", {bone(l->left_leg.root), bone(l->right_leg.root)}},
+                          {"arms", {bone(l->left_arm.root), bone(l->right_arm.root)}}};
+    } else {
+        j["landmarks"] = nullptr;
+        j["landmarks_error"] = body.landmarks_error;
+    }
     j["clips"] = json::array();
     for (const auto& clip : c.clips)
         j["clips"].push_back({{"name", clip->name}, {"duration_s", clip->duration_s}, {"channels", clip->channels.size()},
@@ -95,9 +124,8 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
                                    {"radii_m", {e.radii_m.x(), e.radii_m.y(), e.radii_m.z()}},
                                    {"bulge_m", i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0}});
     }
-    j["coverage"] = {{"share", r.coverage},           {"vertices", r.vertices},         {"covered", r.covered},
-                     {"tolerance_m", r.tolerance_m},   {"max_gap_m", r.max_gap_m},       {"surface_m2", r.surface_m2},
-                     {"outside_share", r.outside_share}, {"mean_bulge_m", r.mean_bulge_m}, {"p95_bulge_m", r.p95_bulge_m},
+    j["coverage"] = {{"share", r.coverage}, {"vertices", r.vertices}, {"covered", r.covered}, {"tolerance_m", r.tolerance_m},
+                     {"max_gap_m", r.max_gap_m}, {"mean_bulge_m", r.mean_bulge_m}, {"p95_bulge_m", r.p95_bulge_m},
                      {"max_bulge_m", r.max_bulge_m}};
     return j.dump(2) + "\n";
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "components/animation_player.hpp"
+#include "components/body_landmarks.hpp"
 #include "components/character.hpp"
 #include "components/skeleton.hpp"
 #include "components/skinned_mesh.hpp"
@@ -47,7 +48,8 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
     }
 
     const Entity e = registry.create();
-    registry.emplace<Character>(e, Character{asset->name, asset, asset->height_m});
+    registry.emplace<Character>(e, Character{asset->name, asset, body.landmarks ? body.landmarks->height_m : asset->height_m});
+    if (body.landmarks) registry.emplace<BodyLandmarks>(e, *body.landmarks);
     Transform& transform = registry.emplace<Transform>(e, options.transform);
     transform.rotation.normalize();
     AnimationPlayer& player = registry.emplace<AnimationPlayer>(e);

@@ -1,9 +1,11 @@
 // Every third-party character in ../shared/assets/characters imports with its clips,
 // bones and normalised weights, and gets fitted ellipsoids that cover it. These files
-// live outside the project; without them the tests skip and say so.
+// live outside the project; without them the tests skip and say so, except under CI.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <string_view>
 
 #include "engine/assets/character_import.hpp"
 #include "systems/character/character_body.hpp"
@@ -14,8 +16,14 @@ namespace {
 
 std::filesystem::path shared(const char* relative) { return std::filesystem::path(DRAPE_SHARED_ASSETS) / relative; }
 
-#define REQUIRE_SHARED(path)                                                                          \
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared test characters absent: " << (path)
+// Absent on a clone without ../shared: skipped there, but a failure under CI (CI=true),
+// where the characters must be present.
+#define REQUIRE_SHARED(path)                                                                             \
+    if (!std::filesystem::exists(path)) {                                                                \
+        if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true")                    \
+            FAIL() << "shared test characters absent under CI: " << (path);                             \
+        GTEST_SKIP() << "shared test characters absent: " << (path);                                     \
+    }
 
 struct Expect {
     const char* file;
@@ -59,32 +67,18 @@ TEST_P(SharedCharacter, ImportsWithClipsBonesNormalisedWeightsAndCoveringEllipso
     skinning_matrices(*c.skeleton, global, skinning);
     Matrix3X p, n;
     skin_mesh(m, skinning, Affine3::Identity(), p, n);
-    const CoverageReport report = measure_coverage(body.ellipsoids, global, p, n, m.indices);
+    const CoverageReport report = measure_coverage(body.ellipsoids, global, p, n);
     EXPECT_GE(report.coverage, 0.95) << e.file;
     if (e.human) {
-        // Within the budget; a bone may carry several ellipsoids where one cannot hug it.
         EXPECT_GE(body.ellipsoids.size(), 10u);
-        EXPECT_LE(body.ellipsoids.size(), std::size_t(FitOptions{}.max_ellipsoids));
+        EXPECT_LE(body.ellipsoids.size(), 20u);
         EXPECT_GE(body.hip_bone, 0);
         EXPECT_TRUE(std::any_of(body.ellipsoids.begin(), body.ellipsoids.end(), [](auto& s) { return s.region == BodyRegion::pelvis; }));
-        // Hands, feet and thighs on both sides; fingers merge into their hand: every hand
-        // ellipsoid is bound to a bone whose parent is no hand bone, and none crosses sides.
-        const SkeletonAsset& sk = *c.skeleton;
-        auto side_count = [&](BodyRegion r, int side) {
-            return std::count_if(body.ellipsoids.begin(), body.ellipsoids.end(), [&](auto& s) {
-                return s.region == r && (global[std::size_t(s.bone)].translation().x() > 0 ? 1 : -1) == side;
-            });
-        };
-        for (BodyRegion r : {BodyRegion::hand, BodyRegion::foot, BodyRegion::upper_leg})
-            for (int side : {1, -1}) EXPECT_GE(side_count(r, side), 1) << body_region_name(r) << " on side " << side;
-        for (const EllipsoidShape& s : body.ellipsoids) {
-            if (s.region != BodyRegion::hand) continue;
-            const int parent = sk.parents[std::size_t(s.bone)];
-            EXPECT_TRUE(parent < 0 || region_from_bone_name(sk.bone_names[std::size_t(parent)]) != BodyRegion::hand)
-                << sk.bone_names[std::size_t(s.bone)];
-            const Vec3 at = rigid_part(global[std::size_t(s.bone)]) * s.center;
-            EXPECT_GT(at.x() * global[std::size_t(s.bone)].translation().x(), 0) << "a hand ellipsoid crosses to the other side";
-        }
+        // One ellipsoid per hand and per foot: fingers merge, left and right do not.
+        auto count = [&](BodyRegion r) { return std::count_if(body.ellipsoids.begin(), body.ellipsoids.end(), [&](auto& s) { return s.region == r; }); };
+        EXPECT_EQ(count(BodyRegion::hand), 2);
+        EXPECT_EQ(count(BodyRegion::foot), 2);
+        EXPECT_EQ(count(BodyRegion::upper_leg), 2);
         // Standing on the ground, Y up: feet near the bottom, head at the top.
         EXPECT_NEAR(p.row(1).minCoeff(), 0.0f, 0.05f);
     }

@@ -1,0 +1,407 @@
+// Body landmarks from skeleton and skin: see body_landmarks.hpp.
+#include "systems/character/body_landmarks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "engine/assets/skinning.hpp"
+#include "systems/character/ellipsoid_fit.hpp"
+
+namespace drape {
+
+namespace {
+
+using Vec2d = Eigen::Vector2d;
+
+struct Rig {
+    const SkeletonAsset& skeleton;
+    std::vector<std::vector<int>> children;
+    std::vector<Affine3> global;  // rest, bone -> model
+    Matrix3X positions;           // skin at rest, model space
+    std::vector<int> owner;       // dominant bone per vertex
+    std::vector<Real> reach_low, reach_high, reach_side;  // per subtree: lowest/highest skin or joint, widest off the trunk
+};
+
+Vec3 joint(const Rig& rig, int b) { return rig.global[static_cast<std::size_t>(b)].translation(); }
+
+bool in_subtree(const Rig& rig, int bone, int root) {
+    for (int b = bone; b >= 0; b = rig.skeleton.parents[static_cast<std::size_t>(b)])
+        if (b == root) return true;
+    return false;
+}
+
+// Per subtree: lowest and highest point (joints and the skin each bone dominates), and
+// the farthest horizontal distance from `axis`.
+void measure_subtrees(Rig& rig, const Vec3& axis) {
+    const std::size_t n = rig.skeleton.size();
+    rig.reach_low.assign(n, std::numeric_limits<Real>::infinity());
+    rig.reach_high.assign(n, -std::numeric_limits<Real>::infinity());
+    rig.reach_side.assign(n, 0);
+    auto add = [&](std::size_t b, const Vec3& p) {
+        rig.reach_low[b] = std::min(rig.reach_low[b], p.y());
+        rig.reach_high[b] = std::max(rig.reach_high[b], p.y());
+        rig.reach_side[b] = std::max(rig.reach_side[b], Vec3(p.x() - axis.x(), 0, p.z() - axis.z()).norm());
+    };
+    for (std::size_t b = 0; b < n; ++b) add(b, joint(rig, static_cast<int>(b)));
+    for (Eigen::Index v = 0; v < rig.positions.cols(); ++v) add(static_cast<std::size_t>(rig.owner[static_cast<std::size_t>(v)]), rig.positions.col(v));
+    for (std::size_t b = n; b-- > 0;) {  // parents come first: children fold into parents
+        const int p = rig.skeleton.parents[b];
+        if (p < 0) continue;
+        const auto q = static_cast<std::size_t>(p);
+        rig.reach_low[q] = std::min(rig.reach_low[q], rig.reach_low[b]);
+        rig.reach_high[q] = std::max(rig.reach_high[q], rig.reach_high[b]);
+        rig.reach_side[q] = std::max(rig.reach_side[q], rig.reach_side[b]);
+    }
+}
+
+// A chain from `root` down its subtree, following the child whose subtree reaches lowest
+// (legs) or farthest sideways (arms); up to three bones that move skin.
+LimbChain follow_chain(const Rig& rig, int root, bool down) {
+    std::vector<int> chain;
+    for (int b = root; b >= 0 && chain.size() < 8;) {
+        chain.push_back(b);
+        int next = -1;
+        for (int c : rig.children[static_cast<std::size_t>(b)]) {
+            const auto cc = static_cast<std::size_t>(c);
+            if (next < 0 || (down ? rig.reach_low[cc] < rig.reach_low[static_cast<std::size_t>(next)]
+                                  : rig.reach_side[cc] > rig.reach_side[static_cast<std::size_t>(next)]))
+                next = c;
+        }
+        b = next;
+    }
+    // Bones that carry skin; a short bone without skin (a twist or end bone) is skipped.
+    std::vector<int> skinned;
+    std::vector<std::size_t> count(rig.skeleton.size(), 0);
+    for (int o : rig.owner) ++count[static_cast<std::size_t>(o)];
+    for (int b : chain)
+        if (count[static_cast<std::size_t>(b)] > 0) skinned.push_back(b);
+    LimbChain out;
+    if (!skinned.empty()) out.root = skinned[0];
+    if (skinned.size() > 1) out.middle = skinned[1];
+    if (skinned.size() > 2) out.end = skinned[2];
+    if (out.root < 0) out.root = root;
+    return out;
+}
+
+// Convex hull (monotone chain) of 2D points; returns its vertices counter-clockwise.
+std::vector<Vec2d> convex_hull(std::vector<Vec2d> p) {
+    std::sort(p.begin(), p.end(), [](const Vec2d& a, const Vec2d& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+    if (p.size() < 3) return p;
+    std::vector<Vec2d> h(2 * p.size());
+    std::size_t k = 0;
+    auto cross = [](const Vec2d& o, const Vec2d& a, const Vec2d& b) {
+        return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+    };
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    for (std::size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+        while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    h.resize(k - 1);
+    return h;
+}
+
+struct Cut {
+    bool valid = false;
+    Vec3 center = Vec3::Zero();
+    Real half_width = 0, half_depth = 0, girth = 0;
+};
+
+// The section of the skin of `bones` (a mask) at height `y`.
+Cut section(const Rig& rig, const std::vector<std::uint32_t>& indices, const std::vector<char>& bones, Real y,
+            const Vec3& left, const Vec3& forward) {
+    std::vector<Vec2d> points;  // (left, forward) coordinates
+    for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+        const std::uint32_t v[3] = {indices[t], indices[t + 1], indices[t + 2]};
+        bool ours = true;
+        for (std::uint32_t i : v) ours = ours && bones[static_cast<std::size_t>(rig.owner[i])];
+        if (!ours) continue;
+        for (int e = 0; e < 3; ++e) {
+            const Vec3 a = rig.positions.col(v[e]), b = rig.positions.col(v[(e + 1) % 3]);
+            if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
+            const Real s = (y - a.y()) / (b.y() - a.y());
+            const Vec3 p = a + s * (b - a);
+            points.emplace_back(double(p.dot(left)), double(p.dot(forward)));
+        }
+    }
+    Cut cut;
+    const std::vector<Vec2d> hull = convex_hull(points);
+    if (hull.size() < 3) return cut;
+    Vec2d lo = hull[0], hi = hull[0];
+    for (std::size_t i = 0; i < hull.size(); ++i) {
+        cut.girth += Real((hull[(i + 1) % hull.size()] - hull[i]).norm());
+        lo = lo.cwiseMin(hull[i]);
+        hi = hi.cwiseMax(hull[i]);
+    }
+    const Vec2d c = 0.5 * (lo + hi);
+    cut.center = left * Real(c.x()) + forward * Real(c.y()) + Vec3::UnitY() * y;
+    cut.half_width = Real(0.5 * (hi.x() - lo.x()));
+    cut.half_depth = Real(0.5 * (hi.y() - lo.y()));
+    cut.valid = true;
+    return cut;
+}
+
+BodyPoint body_point(const Rig& rig, int bone, const Vec3& rest) {
+    BodyPoint p;
+    p.bone = bone;
+    p.rest_m = rest;
+    if (bone >= 0) p.local_m = rigid_part(rig.global[static_cast<std::size_t>(bone)]).inverse(Eigen::Isometry) * rest;
+    return p;
+}
+
+// The spine bone that carries a point at height `y`: the highest whose joint is not above it.
+int spine_bone_at(const Rig& rig, const std::vector<int>& spine, Real y) {
+    int best = spine.front();
+    for (int b : spine)
+        if (joint(rig, b).y() <= y) best = b;
+    return best;
+}
+
+}  // namespace
+
+Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
+    const std::string at = character.source.string() + ": body landmarks: ";
+    if (!character.skeleton || !character.mesh || character.mesh->vertex_count() == 0)
+        return fail(at + "no skeleton or skin");
+    const SkeletonAsset& skeleton = *character.skeleton;
+    const MeshAsset& mesh = *character.mesh;
+    Rig rig{skeleton, {}, {}, {}, dominant_bones(mesh), {}, {}, {}};
+    const std::size_t n = skeleton.size();
+    rig.children.resize(n);
+    for (std::size_t b = 0; b < n; ++b)
+        if (skeleton.parents[b] >= 0) rig.children[static_cast<std::size_t>(skeleton.parents[b])].push_back(static_cast<int>(b));
+    std::vector<Affine3> skinning;
+    compose_pose(skeleton, skeleton.rest_local, rig.global);
+    skinning_matrices(skeleton, rig.global, skinning);
+    Matrix3X normals;
+    skin_mesh(mesh, skinning, Affine3::Identity(), rig.positions, normals);
+    if (!rig.positions.allFinite()) return fail(at + "the skin at the rest pose is not finite");
+
+    const Real all_low = rig.positions.row(1).minCoeff(), all_high = rig.positions.row(1).maxCoeff();
+    const Real all_height = all_high - all_low;
+    if (!(all_height > 0)) return fail(at + "the skin is flat");
+    Vec3 axis = rig.positions.rowwise().mean();
+    measure_subtrees(rig, axis);
+
+    // Pelvis: a named one, else the highest bone with two children whose skin reaches the floor.
+    BodyLandmarks out;
+    auto reaches_floor = [&](int c) { return rig.reach_low[static_cast<std::size_t>(c)] < all_low + Real(0.2) * all_height; };
+    // A leg hangs from its bone's joint to the floor and does not rise above it; the
+    // pelvis also carries a chain that reaches the top (the spine).
+    auto floor_children = [&](int b) {
+        std::vector<int> legs;
+        const Real at = joint(rig, b).y();
+        for (int c : rig.children[static_cast<std::size_t>(b)])
+            if (reaches_floor(c) && joint(rig, c).y() <= at + Real(0.05) * all_height &&
+                rig.reach_high[static_cast<std::size_t>(c)] < at + Real(0.15) * all_height)
+                legs.push_back(c);
+        bool spine = false;
+        for (int c : rig.children[static_cast<std::size_t>(b)])
+            spine = spine || rig.reach_high[static_cast<std::size_t>(c)] > all_high - Real(0.25) * all_height;
+        if (!spine) legs.clear();
+        return legs;
+    };
+    int pelvis = -1;
+    for (std::size_t b = 0; b < n; ++b)
+        if (region_from_bone_name(skeleton.bone_names[b]) == BodyRegion::pelvis && floor_children(static_cast<int>(b)).size() >= 2) {
+            pelvis = static_cast<int>(b);
+            out.found_by = "bone names";
+            break;
+        }
+    if (pelvis < 0) {
+        for (std::size_t b = 0; b < n; ++b)
+            if (floor_children(static_cast<int>(b)).size() >= 2 && (pelvis < 0 || joint(rig, static_cast<int>(b)).y() > joint(rig, pelvis).y()))
+                pelvis = static_cast<int>(b);
+        out.found_by = "topology";
+    }
+    if (pelvis < 0) return fail(at + "no bone with two legs hanging from it (not a humanoid)");
+    out.pelvis_bone = pelvis;
+
+    // Legs: the two children reaching lowest. Spine: the child reaching highest, up to the top.
+    std::vector<int> legs = floor_children(pelvis);
+    std::sort(legs.begin(), legs.end(), [&](int a, int b) { return rig.reach_low[static_cast<std::size_t>(a)] < rig.reach_low[static_cast<std::size_t>(b)]; });
+    legs.resize(2);
+    int up_child = -1;
+    for (int c : rig.children[static_cast<std::size_t>(pelvis)])
+        if (c != legs[0] && c != legs[1] && (up_child < 0 || rig.reach_high[static_cast<std::size_t>(c)] > rig.reach_high[static_cast<std::size_t>(up_child)]))
+            up_child = c;
+    if (up_child < 0 || rig.reach_high[static_cast<std::size_t>(up_child)] < joint(rig, pelvis).y() + Real(0.2) * all_height)
+        return fail(at + "no spine above the pelvis '" + skeleton.bone_names[static_cast<std::size_t>(pelvis)] + "'");
+    out.spine.push_back(pelvis);
+    for (int b = up_child; b >= 0;) {
+        out.spine.push_back(b);
+        int next = -1;
+        for (int c : rig.children[static_cast<std::size_t>(b)])
+            if (next < 0 || rig.reach_high[static_cast<std::size_t>(c)] > rig.reach_high[static_cast<std::size_t>(next)]) next = c;
+        b = next;
+    }
+
+    // Axis of the trunk: the pelvis joint. Arms: off the spine bone with two children
+    // reaching farthest sideways.
+    axis = joint(rig, pelvis);
+    measure_subtrees(rig, axis);
+    std::vector<int> arms;
+    for (int s : out.spine) {
+        if (s == pelvis) continue;
+        std::vector<int> side;
+        for (int c : rig.children[static_cast<std::size_t>(s)]) {
+            if (std::find(out.spine.begin(), out.spine.end(), c) != out.spine.end()) continue;
+            if (rig.reach_side[static_cast<std::size_t>(c)] > Real(0.15) * all_height) side.push_back(c);
+        }
+        if (side.size() >= 2) {
+            std::sort(side.begin(), side.end(), [&](int a, int b) { return rig.reach_side[static_cast<std::size_t>(a)] > rig.reach_side[static_cast<std::size_t>(b)]; });
+            arms = {side[0], side[1]};
+            out.chest_bone = s;
+            break;
+        }
+    }
+    if (arms.empty()) return fail(at + "no two arms hang from the spine above '" + skeleton.bone_names[static_cast<std::size_t>(pelvis)] + "'");
+    out.head_bone = out.spine.back();
+    // The spine stops at the head's bone with skin: drop end bones that move no skin.
+    {
+        std::vector<std::size_t> count(n, 0);
+        for (int o : rig.owner) ++count[static_cast<std::size_t>(o)];
+        while (out.spine.size() > 2 && count[static_cast<std::size_t>(out.spine.back())] == 0) out.spine.pop_back();
+        out.head_bone = out.spine.back();
+    }
+
+    // Body bones and vertices: the pelvis's subtree, and bones that are neither its
+    // ancestors nor in it (feet bound to the root) whose skin is below the pelvis.
+    std::vector<char> is_body(n, 0), is_ancestor(n, 0);
+    for (int b = skeleton.parents[static_cast<std::size_t>(pelvis)]; b >= 0; b = skeleton.parents[static_cast<std::size_t>(b)]) is_ancestor[static_cast<std::size_t>(b)] = 1;
+    for (std::size_t b = 0; b < n; ++b) {
+        if (in_subtree(rig, static_cast<int>(b), pelvis)) is_body[b] = 1;
+        else if (!is_ancestor[b] && rig.reach_high[b] < joint(rig, pelvis).y()) is_body[b] = 1;
+    }
+    Real floor = std::numeric_limits<Real>::infinity(), top = -floor;
+    for (Eigen::Index v = 0; v < rig.positions.cols(); ++v) {
+        if (!is_body[static_cast<std::size_t>(rig.owner[static_cast<std::size_t>(v)])]) continue;
+        floor = std::min(floor, rig.positions(1, v));
+        top = std::max(top, rig.positions(1, v));
+    }
+    for (std::size_t b = 0; b < n; ++b)
+        if (is_body[b]) out.body_bones.push_back(static_cast<int>(b));
+    out.floor_m = floor;
+    out.top_m = top;
+    out.height_m = top - floor;
+    const Real h = out.height_m;
+    if (!(h > 0)) return fail(at + "the body has no height");
+
+    // Forward: across the line through the hip joints, on the side of model +Z (glTF's and
+    // FBX's front once imported Y up); a foot's shape is too varied to tell toes from heel.
+    Vec3 across = joint(rig, legs[0]) - joint(rig, legs[1]);
+    across.y() = 0;
+    if (!(across.norm() > Real(0.01) * h)) return fail(at + "the two legs hang from one place");
+    Vec3 forward = Vec3::UnitY().cross(across.normalized());
+    if (forward.z() < 0) forward = -forward;
+    out.forward = forward;
+    out.left = out.up.cross(forward).normalized();
+
+    // Sides from geometry.
+    auto side_of = [&](int b) { return (joint(rig, b) - axis).dot(out.left); };
+    if (side_of(legs[0]) < side_of(legs[1])) std::swap(legs[0], legs[1]);
+    if (side_of(arms[0]) < side_of(arms[1])) std::swap(arms[0], arms[1]);
+    out.left_leg = follow_chain(rig, legs[0], true);
+    out.right_leg = follow_chain(rig, legs[1], true);
+    out.left_arm = follow_chain(rig, arms[0], false);
+    out.right_arm = follow_chain(rig, arms[1], false);
+
+    // Trunk bones: the spine below the head, not the arms' or legs' subtrees.
+    std::vector<char> trunk(n, 0), trunk_and_thighs(n, 0), arm(n, 0);
+    for (int s : out.spine)
+        if (s != out.head_bone) trunk[static_cast<std::size_t>(s)] = 1;
+    // A neck bone between chest and head is not trunk.
+    for (std::size_t i = 0; i < out.spine.size(); ++i)
+        if (out.chest_bone >= 0 && i > 0 && out.spine[i - 1] == out.chest_bone) {
+            for (std::size_t j = i; j < out.spine.size(); ++j) trunk[static_cast<std::size_t>(out.spine[j])] = 0;
+            break;
+        }
+    for (std::size_t b = 0; b < n; ++b) {
+        if (in_subtree(rig, static_cast<int>(b), arms[0]) || in_subtree(rig, static_cast<int>(b), arms[1])) arm[b] = 1;
+        trunk_and_thighs[b] = trunk[b];
+    }
+    for (int leg : legs) trunk_and_thighs[static_cast<std::size_t>(follow_chain(rig, leg, true).root)] = 1;
+    for (int leg : legs) trunk_and_thighs[static_cast<std::size_t>(leg)] = 1;
+
+    // Crotch: the lowest skin of the pelvis bone near the midplane.
+    Real crotch = std::numeric_limits<Real>::infinity();
+    for (Eigen::Index v = 0; v < rig.positions.cols(); ++v) {
+        if (rig.owner[static_cast<std::size_t>(v)] != pelvis) continue;
+        if (std::abs((Vec3(rig.positions.col(v)) - axis).dot(out.left)) > Real(0.02) * h) continue;
+        crotch = std::min(crotch, rig.positions(1, v));
+    }
+    if (!std::isfinite(crotch) || crotch > joint(rig, pelvis).y()) crotch = joint(rig, pelvis).y() - Real(0.05) * h;
+    out.crotch_m = crotch;
+
+    // Armpits: the lowest arm skin on a triangle shared with the trunk.
+    const std::vector<std::uint32_t>& indices = mesh.indices;
+    std::array<Real, 2> armpit{std::numeric_limits<Real>::infinity(), std::numeric_limits<Real>::infinity()};
+    for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+        bool touches_trunk = false;
+        for (int e = 0; e < 3; ++e) touches_trunk = touches_trunk || trunk[static_cast<std::size_t>(rig.owner[indices[t + static_cast<std::size_t>(e)]])];
+        if (!touches_trunk) continue;
+        for (int e = 0; e < 3; ++e) {
+            const std::uint32_t v = indices[t + static_cast<std::size_t>(e)];
+            const int o = rig.owner[v];
+            if (!arm[static_cast<std::size_t>(o)]) continue;
+            const int s = in_subtree(rig, o, arms[0]) ? 0 : 1;
+            armpit[static_cast<std::size_t>(s)] = std::min(armpit[static_cast<std::size_t>(s)], rig.positions(1, v));
+        }
+    }
+    for (int s = 0; s < 2; ++s) {
+        const Real shoulder = joint(rig, (s == 0 ? out.left_arm : out.right_arm).root).y();
+        Real& a = armpit[static_cast<std::size_t>(s)];
+        if (!std::isfinite(a) || a > shoulder || a < shoulder - Real(0.15) * h) a = shoulder - Real(0.06) * h;
+    }
+    out.underarm_m = Real(0.5) * (armpit[0] + armpit[1]);
+    out.left_shoulder = body_point(rig, out.left_arm.root, joint(rig, out.left_arm.root));
+    out.right_shoulder = body_point(rig, out.right_arm.root, joint(rig, out.right_arm.root));
+    if (!(out.underarm_m > crotch + Real(0.1) * h))
+        return fail(at + "the armpits are not above the crotch by a tenth of the height");
+
+    // Sections.
+    auto make_section = [&](const Cut& c) {
+        BodySection s;
+        s.center = body_point(rig, spine_bone_at(rig, out.spine, c.center.y()), c.center);
+        s.half_width_m = c.half_width;
+        s.half_depth_m = c.half_depth;
+        s.girth_m = c.girth;
+        return s;
+    };
+    auto extreme = [&](const std::vector<char>& bones, Real from, Real to, bool narrowest) {
+        Cut best;
+        constexpr int samples = 24;
+        for (int i = 0; i <= samples; ++i) {
+            const Real y = from + (to - from) * Real(i) / samples;
+            const Cut c = section(rig, indices, bones, y, out.left, out.forward);
+            if (!c.valid) continue;
+            if (!best.valid || (narrowest ? c.girth < best.girth : c.girth > best.girth)) best = c;
+        }
+        return best;
+    };
+    const Real span = out.underarm_m - crotch;
+    const Cut waist = extreme(trunk_and_thighs, crotch + Real(0.3) * span, crotch + Real(0.8) * span, true);
+    if (!waist.valid) return fail(at + "the trunk's skin has no section between crotch and armpits");
+    const Cut hips = extreme(trunk_and_thighs, crotch, waist.center.y(), false);
+    const Cut chest = extreme(trunk, waist.center.y(), out.underarm_m, false);
+    out.waist = make_section(waist);
+    out.hips = make_section(hips.valid ? hips : waist);
+    out.chest = make_section(chest.valid ? chest : waist);
+    const Vec3 under(waist.center.x(), out.underarm_m, waist.center.z());
+    out.under_arms = body_point(rig, spine_bone_at(rig, out.spine, out.underarm_m), under);
+    return out;
+}
+
+Vec3 landmark_world(const BodyPoint& point, const Skeleton& pose, const Transform& transform) {
+    const Affine3 to_world = transform.matrix();
+    if (point.bone < 0 || static_cast<std::size_t>(point.bone) >= pose.global.size()) return to_world * point.rest_m;
+    return to_world * (rigid_part(pose.global[static_cast<std::size_t>(point.bone)]) * point.local_m);
+}
+
+}  // namespace drape

@@ -1,0 +1,46 @@
+// Finding a character's body landmarks (components/body_landmarks.hpp) from its skeleton
+// and skin at the rest pose (method §2: the garment is fitted to the body it is put on).
+//
+// Trunk and limbs by topology and geometry, the same for every rig: the pelvis is the bone
+// from which two chains hang whose skin reaches the floor (a bone named like hips/pelvis
+// is taken when the rig has one); those chains are the legs, the chain from the pelvis
+// that reaches highest is the spine up to the head, and the chest is the spine bone from
+// which the two chains reaching farthest sideways hang (the arms). Sides come from
+// geometry (left = up x forward; forward is across the line through the hip joints, on
+// the side of model +Z, the front of glTF and of FBX once imported), never from names.
+//
+// Definitions (heights are model-space y at rest):
+//  - body: the skin of the bones of the pelvis's subtree and of bones hanging from above
+//    it that are not its ancestors (feet bound to the root, as in some rigs); the skin of
+//    the pelvis's ancestors (a root carrying a base or a prop) is not body.
+//  - section at a height: the skin triangles of the given bones cut by the horizontal
+//    plane there; the convex outline of the cut gives the centre, half width, half depth
+//    and girth.
+//  - crotch: the lowest skin point of the pelvis bone within 2 % of the height of the
+//    midplane.
+//  - armpit: the lowest skin point of an arm chain on a triangle it shares with the trunk;
+//    where the two are separate pieces (a robot), the shoulder joint less 6 % of the
+//    height. underarm = the mean of the two.
+//  - waist: the narrowest trunk section between 30 % and 80 % of the way from crotch to
+//    underarm; hips: the widest section of trunk and thighs between crotch and waist;
+//    chest: the widest trunk section between waist and underarm.
+#pragma once
+
+#include "components/body_landmarks.hpp"
+#include "components/skeleton.hpp"
+#include "components/transform.hpp"
+#include "engine/assets/character_asset.hpp"
+#include "engine/core/error.hpp"
+
+namespace drape {
+
+/// Finds the landmarks of an imported character at its rest pose. Not a humanoid (no bone
+/// with two legs hanging from it, no spine above it, not two arms): an error naming the
+/// file and what is missing, so that a caller can fall back.
+[[nodiscard]] Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character);
+
+/// Where a landmark is on an animated instance: its bone's current pose, then the
+/// character's Transform (world space). A point without a bone follows the Transform only.
+[[nodiscard]] Vec3 landmark_world(const BodyPoint& point, const Skeleton& pose, const Transform& transform);
+
+}  // namespace drape

@@ -1,0 +1,102 @@
+// Body landmarks from skeleton and skin: the default avatar (named bones), the shared
+// third-party humanoids (Quaternius rigs whose pelvis is found by topology, a robot whose
+// legs hang from another bone than the one named Hips) and a non-humanoid.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string_view>
+
+#include "engine/assets/character_import.hpp"
+#include "systems/character/body_landmarks.hpp"
+
+namespace drape {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::shared_ptr<const CharacterAsset> load(const fs::path& file) {
+    auto c = import_character(file);
+    EXPECT_TRUE(c) << (c ? "" : c.error().message);
+    return c ? *c : nullptr;
+}
+
+bool present_or_skip(const fs::path& file) {
+    if (fs::exists(file)) return true;
+    if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true") ADD_FAILURE() << file << " absent under CI";
+    return false;
+}
+
+// What holds on any humanoid: the order of the heights, limbs on their sides, sections
+// that are real outlines of a trunk.
+void expect_humanoid(const BodyLandmarks& l, const std::string& file) {
+    SCOPED_TRACE(file);
+    EXPECT_NEAR(l.height_m, 1.75, 0.1);  // import normalises these files to a 1.75 m standing height
+    EXPECT_LT(l.floor_m, l.crotch_m);
+    EXPECT_LT(l.crotch_m, l.waist.center.rest_m.y());
+    EXPECT_LT(l.waist.center.rest_m.y(), l.underarm_m);
+    EXPECT_LT(l.underarm_m, l.top_m);
+    EXPECT_GE(l.hips.girth_m, l.waist.girth_m);
+    // The natural waist of a person: roughly 0.55-0.7 of the height above the floor.
+    const Real waist_share = (l.waist.center.rest_m.y() - l.floor_m) / l.height_m;
+    EXPECT_GT(waist_share, 0.5f);
+    EXPECT_LT(waist_share, 0.72f);
+    EXPECT_GT(l.waist.girth_m, 0.4f);
+    EXPECT_LT(l.waist.girth_m, 1.6f);
+    // Left is left: the left leg and arm lie on the +left side of the pelvis.
+    ASSERT_GE(l.left_leg.root, 0);
+    ASSERT_GE(l.right_arm.root, 0);
+    EXPECT_NE(l.left_leg.root, l.right_leg.root);
+    EXPECT_NE(l.left_arm.root, l.right_arm.root);
+    EXPECT_GT((l.left_shoulder.rest_m - l.right_shoulder.rest_m).dot(l.left), 0.03f);
+    EXPECT_NEAR(l.left.dot(l.forward), 0, 1e-5);
+    EXPECT_NEAR(l.up.cross(l.forward).dot(l.left), 1, 1e-5);
+}
+
+TEST(BodyLandmarks, DefaultAvatarByBoneNames) {
+    const fs::path file = fs::path(DRAPE_SOURCE_DIR) / "assets/avatar.glb";
+    ASSERT_TRUE(fs::exists(file)) << "assets/avatar.glb is part of the project";
+    const auto c = load(file);
+    ASSERT_TRUE(c);
+    const auto l = find_body_landmarks(*c);
+    ASSERT_TRUE(l) << l.error().message;
+    EXPECT_EQ(l->found_by, "bone names");
+    EXPECT_EQ(c->skeleton->bone_names.at(std::size_t(l->pelvis_bone)), "Hips");
+    EXPECT_EQ(c->skeleton->bone_names.at(std::size_t(l->left_leg.root)), "LeftUpLeg");
+    EXPECT_EQ(c->skeleton->bone_names.at(std::size_t(l->right_arm.root)), "RightShoulder");
+    expect_humanoid(*l, file.string());
+}
+
+TEST(BodyLandmarks, SharedHumanoidsByTopology) {
+    for (const char* relative : {"characters/male_casual/Male_Casual.fbx", "characters/female_alternative/Female_Alternative.fbx",
+                                 "characters/robot_expressive/RobotExpressive.glb"}) {
+        const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / relative;
+        if (!present_or_skip(file)) continue;
+        const auto c = load(file);
+        ASSERT_TRUE(c);
+        const auto l = find_body_landmarks(*c);
+        ASSERT_TRUE(l) << l.error().message;
+        if (std::string_view(relative).find("robot") != std::string_view::npos) {
+            // A ball of a body: only the order of things and the sides are a person's.
+            EXPECT_LT(l->crotch_m, l->waist.center.rest_m.y());
+            EXPECT_LT(l->waist.center.rest_m.y(), l->underarm_m);
+            EXPECT_GT((l->left_shoulder.rest_m - l->right_shoulder.rest_m).dot(l->left), 0.03f);
+            continue;
+        }
+        expect_humanoid(*l, file.string());
+    }
+}
+
+TEST(BodyLandmarks, ANonHumanoidIsAnErrorNamingTheFile) {
+    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/rigged_simple/RiggedSimple.glb";
+    if (!present_or_skip(file)) GTEST_SKIP() << file << " absent";
+    const auto c = load(file);
+    ASSERT_TRUE(c);
+    const auto l = find_body_landmarks(*c);
+    ASSERT_FALSE(l);
+    EXPECT_NE(l.error().message.find("RiggedSimple.glb"), std::string::npos) << l.error().message;
+    EXPECT_NE(l.error().message.find("not a humanoid"), std::string::npos) << l.error().message;
+}
+
+}  // namespace
+}  // namespace drape
