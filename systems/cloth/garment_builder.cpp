@@ -5,13 +5,16 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include "components/body_landmarks.hpp"
 #include "components/ellipsoid_collider.hpp"
 #include "components/skeleton.hpp"
 #include "components/skinned_mesh.hpp"
 #include "components/transform.hpp"
+#include "systems/character/body_landmarks.hpp"
 #include "systems/cloth/body.hpp"
 #include "systems/cloth/collision.hpp"
 #include "systems/cloth/garment_parameters.hpp"
@@ -224,7 +227,8 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     }
     if (!placed) return fail(p + ": the character's colliders have not been placed yet (run the collider system once)");
 
-    // Body height and axis from the colliders.
+    // Body height and axis: from the landmarks when the character has them, else from the
+    // colliders (their vertical extent; the mean of their centres).
     Real bottom = std::numeric_limits<Real>::infinity(), top = -bottom;
     Vec3 axis = Vec3::Zero();
     int active = 0;
@@ -237,8 +241,25 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     }
     if (active == 0) return fail(p + ": the character's colliders are degenerate (zero radii)");
     axis /= Real(active);
-    const Real height = top - bottom;
-    const Real ring_y = bottom + (s.ring_height_m > 0 ? s.ring_height_m : s.ring_height_fraction * height);
+    Real height = top - bottom;
+    std::optional<Real> landmark_y;
+    const auto* landmarks = registry.try_get<BodyLandmarks>(character);
+    const auto* pose = registry.try_get<Skeleton>(character);
+    const auto* transform = registry.try_get<Transform>(character);
+    if (landmarks && pose && transform && !pose->global.empty()) {
+        const BodyPoint& at = s.ring_at == RingPlace::waist ? landmarks->waist.center : landmarks->under_arms;
+        const Vec3 ring = landmark_world(at, *pose, *transform);
+        const Vec3 floor = transform->matrix() * Vec3(ring.x(), landmarks->floor_m, ring.z());
+        height = landmarks->height_m * transform->scale;
+        bottom = floor.y();
+        axis = ring;
+        // Under the arms: a little lower, so that the arms' skin clears the cloth.
+        landmark_y = ring.y() - (s.ring_at == RingPlace::under_arms ? Real(0.02) * height : Real(0));
+    }
+    Real ring_y = bottom + fallback_ring_height_fraction(s.ring_at) * height;
+    if (s.ring_height_m > 0) ring_y = bottom + s.ring_height_m;
+    else if (s.ring_height_fraction > 0) ring_y = bottom + s.ring_height_fraction * height;
+    else if (landmark_y) ring_y = *landmark_y;
     const Vec3 origin(axis.x(), ring_y, axis.z());
 
     // Outline colliders: cross the ring height, near the axis.
@@ -298,6 +319,10 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
 }
 
 }  // namespace
+
+Real fallback_ring_height_fraction(RingPlace place) noexcept {
+    return place == RingPlace::waist ? Real(0.58) : Real(0.72);
+}
 
 Result<void> validate(const ClothMaterial& m, std::string_view p) {
     for (const GarmentParameterSpec& spec : garment_parameters())

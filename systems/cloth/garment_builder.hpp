@@ -3,10 +3,12 @@
 //
 // Placement (skirt and dress): the character's colliders are the EllipsoidCollider
 // entities whose `character` is that entity, in entity order, and must have been placed
-// (the collider system has run, or a test set `world` and `initialised`). The body's
-// height is the vertical extent of its colliders; the body axis is vertical through the
-// mean of their centres. At the ring height (the waist for a skirt, the shoulders for a
-// dress) the outline of the colliders that cross that height and lie near the axis (not
+// (the collider system has run, or a test set `world` and `initialised`). On a character
+// with BodyLandmarks (systems/character/body_landmarks.hpp) the ring sits at its waist
+// (skirt) or 2 % of its height under the armpits (dress), on the vertical axis through
+// that landmark as the character stands now; elsewhere the body's height is the vertical
+// extent of its colliders, the axis runs through the mean of their centres and the ring
+// sits at a fixed share of the height. At the ring height the outline of the colliders that cross that height and lie near the axis (not
 // arms or hands) is sampled along each warp line's direction; the garment is a truncated
 // cone from that outline (plus ease), flaring outward, and is then pushed out of every
 // collider. The top `fitting_rows` rows are pinned (method §3.5):
@@ -18,6 +20,7 @@
 // ranges are those of the garment parameter table (systems/cloth/garment_parameters.hpp).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <string_view>
@@ -28,10 +31,18 @@
 
 namespace drape {
 
+/// Where a tube's ring sits on a body with landmarks (components/body_landmarks.hpp).
+enum class RingPlace : std::uint8_t {
+    waist,       ///< BodyLandmarks::waist: a skirt.
+    under_arms,  ///< Just under the armpits (BodyLandmarks::under_arms): a strapless dress.
+};
+
+/// Ring height / body height on a body without landmarks (a non-humanoid, an analytic body).
+[[nodiscard]] Real fallback_ring_height_fraction(RingPlace place) noexcept;
+
 /// A skirt or a dress: a tube hung from a ring around the body, flaring into a truncated
 /// cone (see the placement rules above). A skirt and a dress differ only in their values:
-/// the ring is the waist for a skirt (the fitted hip ellipsoids) and the shoulders for a
-/// dress. The defaults are the skirt's (`skirt()`); `dress()` gives the dress's. Ranges,
+/// the ring is the waist for a skirt and under the arms for a dress. The defaults are the skirt's (`skirt()`); `dress()` gives the dress's. Ranges,
 /// units and meanings of the numeric fields: the garment parameter table
 /// (systems/cloth/garment_parameters.hpp), which validate(TubeParams) walks.
 struct TubeParams {
@@ -41,7 +52,8 @@ struct TubeParams {
     Real length_m = Real(0.55);       ///< Along the cone from the ring to the hem.
     Real flare_deg = Real(18);        ///< Cone half-angle from vertical.
     Real ease_m = Real(0.01);         ///< Gap between the body outline at the ring and the cloth.
-    Real ring_height_fraction = Real(0.58);  ///< Ring height / body height: the waist (skirt) or the shoulders (dress); used when ring_height_m is 0.
+    RingPlace ring_at = RingPlace::waist;  ///< Where the ring sits on a character with BodyLandmarks.
+    Real ring_height_fraction = 0;    ///< > 0: ring height / body height instead (used when ring_height_m is 0).
     Real ring_height_m = 0;           ///< > 0: ring height above the body's lowest point.
     Real torso_radius_fraction = Real(0.12);  ///< Colliders centred farther than this x height from the axis (arms) are not outline.
     int fitting_rows = 1;             ///< Rows pinned to the body (method §3.5).
@@ -63,7 +75,7 @@ struct TubeParams {
         p.length_m = Real(1.05);
         p.flare_deg = Real(10);
         p.ease_m = Real(0.015);
-        p.ring_height_fraction = Real(0.72);  // under the arms: the arms stay outside the dress
+        p.ring_at = RingPlace::under_arms;  // the arms stay outside the dress
         p.fitting_rows = 2;
         p.color = Vec3(0.15f, 0.3f, 0.7f);
         return p;

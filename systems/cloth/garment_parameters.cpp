@@ -100,7 +100,7 @@ GarmentParameterSpec real(std::string_view name, Real Owner::*field, ParameterRa
 
 ParameterRange closed(double min, double max) { return {min, max, false, false}; }
 ParameterRange open_min(double min, double max) { return {min, max, true, false}; }  // (min, max]
-ParameterRange open_both(double min, double max) { return {min, max, true, true}; }
+ParameterRange open_max(double min, double max) { return {min, max, false, true}; }  // [min, max)
 
 // Grid sides: the builder's limit per side (build_grid_topology); together at most
 // max_garment_particles.
@@ -119,8 +119,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
         real("length_m", &TubeParams::length_m, open_min(0, 10), "m", "from the ring to the hem, along the cloth"),
         real("flare_deg", &TubeParams::flare_deg, closed(0, 80), "deg", "cone half-angle from vertical"),
         real("ease_m", &TubeParams::ease_m, closed(0, 1), "m", "gap between the body outline at the ring and the cloth"),
-        real("ring_height_fraction", &TubeParams::ring_height_fraction, open_both(0, 1), "",
-             "ring height / body height: the waist for a skirt, the shoulders for a dress (used when `ring_height_m` is 0)"),
+        real("ring_height_fraction", &TubeParams::ring_height_fraction, open_max(0, 1), "",
+             "> 0: ring height / body height (used when `ring_height_m` is 0); 0: at the body's waist for a skirt, under the arms for a dress"),
         real("ring_height_m", &TubeParams::ring_height_m, closed(0, 10), "m",
              "> 0: ring height above the body's lowest point (0: from `ring_height_fraction`)"),
         real("torso_radius_fraction", &TubeParams::torso_radius_fraction, open_min(0, 1), "",

@@ -117,7 +117,6 @@ void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSub
 
 void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
-    const Fabric& t = *g.fabric;
     Matrix3X& x = g.state.x;
     Matrix3X& v = g.state.v;
     const Real h = static_cast<Real>(sub.h_s);

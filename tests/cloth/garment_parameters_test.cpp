@@ -66,7 +66,7 @@ TEST(GarmentParameterTable, ValidateNamesTheRowAndItsRange) {
     find_garment_parameter("ring_height_fraction")->set(p, 1);
     r = validate(p, "dress");
     ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().message, "dress.ring_height_fraction: must be in (0, 1), got 1");
+    EXPECT_EQ(r.error().message, "dress.ring_height_fraction: must be in [0, 1), got 1");
     p = TubeParams::skirt();
     find_garment_parameter("iterations")->set(p, 1e6);
     EXPECT_EQ(validate(p, "skirt").error().message, "skirt.material.iterations: must be in [1, 100], got 1000000");

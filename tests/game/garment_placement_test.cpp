@@ -1,0 +1,93 @@
+// Where a garment is put on: a skirt's fitting ring at the character's waist, a dress's
+// just under its arms (the body's landmarks), on the default avatar and, when present,
+// on a third-party character whose pelvis is found by topology; a set height overrides.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string_view>
+
+#include "components/body_landmarks.hpp"
+#include "components/garment.hpp"
+#include "components/skeleton.hpp"
+#include "components/transform.hpp"
+#include "game/sample_scene.hpp"
+#include "game/world.hpp"
+#include "systems/character/body_landmarks.hpp"
+
+namespace drape {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Mean height of the pinned particles and the landmarks' heights, world space, as built.
+struct Placed {
+    Real ring_y = 0, waist_y = 0, under_arms_y = 0, height = 0;
+};
+
+Placed place(const fs::path& file, GarmentType type, Real ring_height_fraction = 0) {
+    SceneDescription scene = sample_scene();
+    scene.characters.at(0).file = file;
+    scene.characters.at(0).clip = "";
+    scene.garments.at(0).type = type;
+    if (ring_height_fraction > 0) scene.garments.at(0).parameters.push_back({"ring_height_fraction", ring_height_fraction});
+    auto world = build_world(scene, {});
+    EXPECT_TRUE(world) << (world ? "" : world.error().message);
+    Placed out;
+    if (!world) return out;
+    const Entity character = world->characters.at(0);
+    const auto* l = world->registry.try_get<BodyLandmarks>(character);
+    EXPECT_NE(l, nullptr) << file << " has no landmarks";
+    if (!l) return out;
+    const Skeleton& pose = world->registry.get<Skeleton>(character);
+    const Transform& transform = world->registry.get<Transform>(character);
+    out.waist_y = landmark_world(l->waist.center, pose, transform).y();
+    out.under_arms_y = landmark_world(l->under_arms, pose, transform).y();
+    out.height = l->height_m * transform.scale;
+    const Garment& g = world->registry.get<Garment>(world->garments.at(0));
+    int pinned = 0;
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i)
+        if (g.state.inv_mass[i] == 0) {
+            out.ring_y += g.state.x(1, i);
+            ++pinned;
+        }
+    EXPECT_GT(pinned, 0);
+    out.ring_y /= Real(std::max(pinned, 1));
+    return out;
+}
+
+// The pinned rows hang from the ring: their mean is within a few centimetres below it.
+void expect_at(Real ring_y, Real at_y) {
+    EXPECT_LT(ring_y, at_y + 0.01f);
+    EXPECT_GT(ring_y, at_y - 0.05f);
+}
+
+TEST(GarmentPlacement, SkirtAtTheWaistDressUnderTheArmsOfTheDefaultAvatar) {
+    const fs::path avatar = sample_scene().characters.at(0).file;
+    ASSERT_TRUE(fs::exists(avatar));
+    const Placed skirt = place(avatar, GarmentType::skirt);
+    expect_at(skirt.ring_y, skirt.waist_y);
+    const Placed dress = place(avatar, GarmentType::dress);
+    expect_at(dress.ring_y, dress.under_arms_y - 0.02f * dress.height);
+    EXPECT_GT(dress.ring_y, skirt.ring_y + 0.1f);
+}
+
+TEST(GarmentPlacement, ASetFractionOverridesTheLandmark) {
+    const fs::path avatar = sample_scene().characters.at(0).file;
+    const Placed skirt = place(avatar, GarmentType::skirt, 0.45f);
+    EXPECT_LT(skirt.ring_y, skirt.waist_y - 0.1f);
+    EXPECT_NEAR(skirt.ring_y, 0.45f * skirt.height, 0.05f);
+}
+
+TEST(GarmentPlacement, SkirtAtTheWaistOfAThirdPartyCharacter) {
+    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/female_alternative/Female_Alternative.fbx";
+    if (!fs::exists(file)) {
+        if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true") FAIL() << file << " absent under CI";
+        GTEST_SKIP() << file << " absent (the shared third-party characters are optional)";
+    }
+    const Placed skirt = place(file, GarmentType::skirt);
+    expect_at(skirt.ring_y, skirt.waist_y);
+}
+
+}  // namespace
+}  // namespace drape
