@@ -429,6 +429,18 @@ Real penetration_depth(const EllipsoidFrame& f, const Vec3& x) {
     return centre_line_depth(f, d, y_len, 1 / y_len);
 }
 
+Vec3 leave_ellipsoid(const EllipsoidFrame& f, const Vec3& x) {
+    Vec3 out = x;
+    const Vec3 d = x - f.center;
+    const Vec3 y = f.to_unit * d;
+    const Real y_sq = y.squaredNorm();
+    if (y_sq >= 1) return out;
+    const Real y_len = std::sqrt(y_sq);
+    const Real inv_len = y_len > 0 ? 1 / y_len : 0;
+    place_shortest(f, y, y_sq, inv_len, centre_line_depth(f, d, y_len, inv_len), out, 1 + surface_clearance(f));
+    return out;
+}
+
 void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v) {
     remove_approach(f, place_on_surface(f, y, x, 1 + surface_clearance(f)), x, v);
 }

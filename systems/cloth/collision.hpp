@@ -53,6 +53,11 @@ namespace drape {
 /// Distance the centre-line response would move `x` out of the ellipsoid (0 when outside), m.
 [[nodiscard]] Real penetration_depth(const EllipsoidFrame& f, const Vec3& x);
 
+/// The nearest place outside the ellipsoid for a point inside it, by the shortest of the
+/// normal and the centre line (the contact response's rule), plus the clearance; a point
+/// outside is returned as it is.
+[[nodiscard]] Vec3 leave_ellipsoid(const EllipsoidFrame& f, const Vec3& x);
+
 /// Moves x onto the surface along the centre line and removes the normal velocity
 /// relative to the surface (method §5). `y` = to_unit_sphere(f, x), |y| < 1.
 void push_out(const EllipsoidFrame& f, const Vec3& y, Vec3& x, Vec3& v);

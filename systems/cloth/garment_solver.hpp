@@ -62,6 +62,7 @@ struct GarmentSolver {
     CandidateLists lists;
 
     Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
+    std::vector<EllipsoidFrame> pin_frames;  ///< Scratch: the colliders at the end of the fixed step, for the pins.
     Matrix2X weft_offsets;                   ///< Simplified: each layer-2 particle's place in its plane (weft.hpp).
     bool weft_offsets_valid = false;         ///< False: taken from the positions at the next step.
     Vec3 anchor_velocity_before = Vec3::Zero();      ///< The anchor's V when the velocities were last written.

@@ -1,6 +1,7 @@
 // Where a garment is put on: a skirt's fitting ring at the character's waist, a dress's
 // just under its arms (the body's landmarks), on the default avatar and, when present,
-// on a third-party character whose pelvis is found by topology; a set height overrides.
+// on a third-party character whose pelvis is found by topology; a set height overrides;
+// the pinned points stay outside the ellipsoids.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include "game/sample_scene.hpp"
 #include "game/world.hpp"
 #include "systems/character/body_landmarks.hpp"
+#include "systems/cloth/garment_quality.hpp"
 
 namespace drape {
 namespace {
@@ -87,6 +89,24 @@ TEST(GarmentPlacement, SkirtAtTheWaistOfAThirdPartyCharacter) {
     }
     const Placed skirt = place(file, GarmentType::skirt);
     expect_at(skirt.ring_y, skirt.waist_y);
+}
+
+// Fitting-zone points sit on or outside the ellipsoids after every frame of the walk, also
+// where an arm's ellipsoid hangs against the chest at a dress's ring.
+TEST(GarmentPlacement, PinsStayOutsideTheEllipsoidsOnTheWalk) {
+    for (GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+        SceneDescription scene = sample_scene();
+        scene.garments.at(0).type = type;
+        auto world = build_world(scene, {});
+        ASSERT_TRUE(world) << world.error().message;
+        const Garment& g = world->registry.get<Garment>(world->garments.at(0));
+        Real worst = 0;
+        for (int frame = 0; frame < 90; ++frame) {
+            ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+            worst = std::max(worst, measure_garment(world->registry, g).pins_inside_m);
+        }
+        EXPECT_LE(worst, 0.5e-3f) << garment_type_name(type);
+    }
 }
 
 }  // namespace
