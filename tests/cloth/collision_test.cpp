@@ -402,10 +402,15 @@ TEST(Collision, BruteForceAndListsGiveTheSameGarmentOnAStaticBody) {
         scheduler.add(body.system(registry));
         add_cloth_systems(scheduler);
         for (int i = 0; i < 30; ++i) (void)scheduler.tick(registry, 1.0 / 60.0);
-        return registry.get<Garment>(e).counters.collisions;
+        const Garment& g = registry.get<Garment>(e);
+        return std::pair{g.counters.collisions, Matrix3X(g.state.x)};
     };
-    EXPECT_GT(run(CollisionMode::candidate_lists), 0u);
-    EXPECT_GT(run(CollisionMode::brute_force), 0u);
+    const auto [list_collisions, with_lists] = run(CollisionMode::candidate_lists);
+    const auto [brute_collisions, brute] = run(CollisionMode::brute_force);
+    EXPECT_GT(list_collisions, 0u);
+    EXPECT_EQ(list_collisions, brute_collisions);
+    ASSERT_EQ(with_lists.cols(), brute.cols());
+    EXPECT_LT((with_lists - brute).cwiseAbs().maxCoeff(), 1e-5f);
 }
 
 }  // namespace

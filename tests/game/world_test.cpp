@@ -320,9 +320,16 @@ TEST(BuildWorld, RandomGarmentParametersGiveAWorldOrOneError) {
         }
         ++built;
         for (int frame = 0; frame < 5; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+        // The collision step resets a garment that went non-finite, so finite positions
+        // alone prove nothing: no value may have gone non-finite and no reset may have run.
         EXPECT_FALSE(has_nonfinite(*world)) << to_json(scene);
+        const Garment& garment = world->registry.get<Garment>(world->garments.at(0));
+        EXPECT_EQ(garment.counters.non_finite_values, 0u) << to_json(scene);
+        EXPECT_EQ(garment.counters.resets, 0u) << to_json(scene);
     }
-    EXPECT_EQ(built + rejected, 16);
+    // Both outcomes occur among the cases: the property is exercised on both sides.
+    EXPECT_GT(built, 0);
+    EXPECT_GT(rejected, 0);
 }
 
 }  // namespace
