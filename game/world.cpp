@@ -90,6 +90,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         spawn.clip = c.clip;
         spawn.speed = c.speed;
         spawn.in_place = c.in_place;
+        spawn.start_time_s = c.start_s;
         if (!c.clip.empty()) {
             if (auto clip = find_clip(*asset, c.clip); !clip)
                 return fail(located(c.where, "characters[" + std::to_string(i) + "].clip", clip.error().message));
