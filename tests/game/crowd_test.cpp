@@ -117,6 +117,27 @@ TEST(Crowd, OneOrTwoThreadsGiveIdenticalBytes) {
     EXPECT_TRUE(one == two) << "six walkers differ between one and two worker threads";
 }
 
+TEST(Crowd, AGarmentStepsTheSameWhoeverElseIsInTheScene) {
+    if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
+    // Neighbours on other phases need other substep counts at other times; the first
+    // walker's skirt takes its own.
+    auto alone = build_world(walkers(1, 0.0, 0), {});
+    auto crowd = build_world(walkers(4, 0.29, 0), {});
+    ASSERT_TRUE(alone && crowd);
+    bool substeps_differed = false;
+    for (int f = 0; f < 60; ++f) {
+        ASSERT_TRUE(step_world(*alone, 1.0 / 60.0));
+        ASSERT_TRUE(step_world(*crowd, 1.0 / 60.0));
+        for (Entity e : crowd->garments)
+            substeps_differed |= crowd->registry.get<Garment>(e).counters.substeps !=
+                                 crowd->registry.get<Garment>(crowd->garments[0]).counters.substeps;
+    }
+    EXPECT_TRUE(substeps_differed) << "the walkers never needed different substeps: the test shows nothing";
+    const Garment& a = alone->registry.get<Garment>(alone->garments[0]);
+    const Garment& b = crowd->registry.get<Garment>(crowd->garments[0]);
+    EXPECT_TRUE(a.state.x == b.state.x && a.state.v == b.state.v);
+}
+
 TEST(Crowd, StartTimePutsWalkersOnDifferentPhases) {
     if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
     auto world = build_world(walkers(2, 0.4, 0), {});
