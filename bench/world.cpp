@@ -20,6 +20,7 @@ SceneDescription scene_for(const WorldSpec& spec) {
         if (c.file.empty()) c.file = default_avatar_path();
         c.position_m = Vec3(1.5f * static_cast<Real>(i % columns), 0, -1.5f * static_cast<Real>(i / columns));
         c.in_place = spec.in_place;
+        c.start_s = spec.phase_step_s * i;
         scene.characters.push_back(c);
         GarmentDescription g;
         g.type = spec.garment;

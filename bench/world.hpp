@@ -23,6 +23,7 @@ struct WorldSpec {
     int threads = 1;
     bool profile = true;                               ///< Time every system run.
     bool in_place = true;                              ///< false: root motion moves the walkers.
+    double phase_step_s = 0;                           ///< Walker i starts i x this into its clip (0: all in step).
     bool render = false;                               ///< Off-screen renderer + render system (1280x720).
 };
 

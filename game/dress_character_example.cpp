@@ -65,13 +65,13 @@ int main(int argc, char** argv) {
     auto character = drape::spawn_character(registry, *asset, *body, spawn);
     if (!character) return fail_with(character.error().message);
 
-    // 3. Systems: animation, skinning, colliders, then the cloth's three systems.
+    // 3. Systems: animation, colliders, then the cloth's three systems.
     drape::Scheduler scheduler;
     drape::add_character_systems(scheduler);
     drape::add_cloth_systems(scheduler);
 
     // 4. The skirt: a cone hung from the fitted hip ellipsoids, top row pinned to the skin.
-    //    The builder fits around placed colliders: one skinning pass places them.
+    //    The builder fits around placed colliders: one pass of the skinning phase places them.
     scheduler.run_phase(registry, drape::Phase::skinning, drape::FrameContext{.fixed_dt_s = 1.0 / 60.0});
     const drape::TubeParams skirt = drape::TubeParams::skirt();  // 27 x 31 = 837 particles, the paper's skirt
     auto garment = drape::attach_skirt(registry, *character, skirt);

@@ -43,6 +43,7 @@ struct CharacterDescription {
     Vec3 rotation_deg = Vec3::Zero();    ///< Euler angles, applied as yaw (Y) * pitch (X) * roll (Z).
     double speed = 1;                    ///< Playback rate of the clip.
     bool in_place = true;                ///< true: the walk stays in place; false: root motion moves the character.
+    double start_s = 0;                  ///< Clip time at the start (where in its cycle the character begins), s.
     SourceLocation where;                ///< Of the "file" field, for load errors.
 
     [[nodiscard]] Quat rotation() const;

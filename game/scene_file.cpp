@@ -440,6 +440,7 @@ CharacterDescription read_character(const Reader& r, const std::string& path, co
     if (const Json* v = f.get("rotation_deg")) c.rotation_deg = read_vec3(r, f.path("rotation_deg"), *v, -3600, 3600);
     if (const Json* v = f.get("speed")) c.speed = read_real(r, f.path("speed"), *v, 0, 100);
     if (const Json* v = f.get("in_place")) c.in_place = read_bool(r, f.path("in_place"), *v);
+    if (const Json* v = f.get("start_s")) c.start_s = read_real(r, f.path("start_s"), *v, 0, 100000);
     f.finish();
     return c;
 }
@@ -661,6 +662,7 @@ std::string to_json(const SceneDescription& scene) {
         o["rotation_deg"] = vec(c.rotation_deg);
         o["speed"] = c.speed;
         o["in_place"] = c.in_place;
+        if (c.start_s != 0) o["start_s"] = c.start_s;
         characters.push_back(std::move(o));
     }
     j["characters"] = std::move(characters);

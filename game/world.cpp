@@ -9,6 +9,7 @@
 #include "components/animation_player.hpp"
 #include "components/character.hpp"
 #include "components/garment.hpp"
+#include "components/skeleton.hpp"
 #include "components/skinned_mesh.hpp"
 #include "engine/assets/character_import.hpp"
 #include "game/collider_overrides.hpp"
@@ -25,6 +26,7 @@
 #ifdef DRAPE_HAVE_RENDER
 #include "engine/render/renderer.hpp"
 #include "systems/render_system.hpp"
+#include "systems/skinning_system.hpp"
 #endif
 
 namespace drape {
@@ -88,6 +90,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         spawn.clip = c.clip;
         spawn.speed = c.speed;
         spawn.in_place = c.in_place;
+        spawn.start_time_s = c.start_s;
         if (!c.clip.empty()) {
             if (auto clip = find_clip(*asset, c.clip); !clip)
                 return fail(located(c.where, "characters[" + std::to_string(i) + "].clip", clip.error().message));
@@ -105,8 +108,8 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
     ClothSolverSettings cloth;
     cloth.fixed_substeps = scene.solver.substeps;
     add_cloth_systems(world.scheduler, cloth);
-    // The garment builders fit around placed colliders (overrides included): one skinning
-    // pass (skinning, colliders) places them before the first step.
+    // The garment builders fit around placed colliders (overrides included): one pass of
+    // the skinning phase (colliders) places them before the first step.
     world.scheduler.run_phase(world.registry, Phase::skinning, FrameContext{.fixed_dt_s = scene.solver.fixed_dt_s});
 
     // Garments.
@@ -142,6 +145,8 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         camera.yaw_rad = c.yaw_deg * degrees;
         camera.pitch_rad = c.pitch_deg * degrees;
         camera.fov_y_rad = c.fov_deg * degrees;
+        // The mesh is skinned for drawing only, once per frame, just before it is drawn.
+        world.scheduler.add(make_skinning_system());
         world.scheduler.add(make_render_system(*world.renderer));
 #else
         return fail("rendering: this build has no render module (configured with -DDRAPE_RENDER=OFF)");
@@ -193,8 +198,12 @@ RunStats run_stats(const World& world) {
 bool has_nonfinite(const World& world) {
     for (Entity e : world.garments)
         if (const Garment* g = world.registry.try_get<Garment>(e); g && (!g->state.x.allFinite() || !g->state.v.allFinite())) return true;
-    for (Entity e : world.characters)
+    for (Entity e : world.characters) {
         if (const SkinnedMesh* m = world.registry.try_get<SkinnedMesh>(e); m && !m->positions.allFinite()) return true;
+        if (const Skeleton* s = world.registry.try_get<Skeleton>(e))
+            for (const Affine3& bone : s->skinning)
+                if (!bone.matrix().allFinite()) return true;
+    }
     return false;
 }
 

@@ -7,8 +7,9 @@
 //   for (int i = 0; i < 600; ++i) drape::step_world(*world, 1.0 / 60.0);
 //
 // Systems, in phase order (engine/core/scheduler.hpp): the character systems (animation,
-// skinning, colliders), then the teleport guard (systems/teleport_guard_system.hpp), then
-// the cloth systems, then (when rendering) the render system.
+// colliders), then the teleport guard (systems/teleport_guard_system.hpp), then the cloth
+// systems, then, only when rendering, the skinning system (the mesh, once per frame) and
+// the render system. A headless world skins no mesh vertex.
 //
 // Robustness (method-independent, docs/scenes.md "solver"):
 // - hitches: step_world clamps a frame time to `solver.max_frame_dt_s` before the
@@ -80,7 +81,7 @@ void set_garment_model(World& world, ClothModel model);
 /// Run statistics so far (the --stats file).
 [[nodiscard]] RunStats run_stats(const World& world);
 
-/// True when a garment particle, velocity or body vertex is not finite.
+/// True when a garment particle, velocity, skinning matrix or skinned body vertex is not finite.
 [[nodiscard]] bool has_nonfinite(const World& world);
 
 /// Whether this build has the render module.

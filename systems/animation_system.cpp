@@ -2,6 +2,10 @@
 #include "systems/animation_system.hpp"
 
 #include <cmath>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "components/animation_player.hpp"
 #include "components/skeleton.hpp"
@@ -38,9 +42,17 @@ System make_animation_system() {
     s.reads = {};
     s.writes = components<AnimationPlayer, Skeleton>();
     s.optional_reads = components<Transform>();
-    s.run = [](Registry& registry, const FrameContext& context) {
-        registry.view<AnimationPlayer, Skeleton>().each([&](Entity e, AnimationPlayer& player, Skeleton& skeleton) {
-            advance_animation(player, skeleton, registry.try_get<Transform>(e), context.fixed_dt_s);
+    // Characters are independent (each task writes one player, skeleton and transform), so
+    // they are posed in parallel; the result does not depend on the thread count.
+    s.run = [entities = std::vector<Entity>{}](Registry& registry, const FrameContext& context) mutable {
+        entities.clear();
+        registry.view<AnimationPlayer, Skeleton>().each([&](Entity e, AnimationPlayer&, Skeleton&) { entities.push_back(e); });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, entities.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                const Entity e = entities[i];
+                advance_animation(registry.get<AnimationPlayer>(e), registry.get<Skeleton>(e), registry.try_get<Transform>(e),
+                                  context.fixed_dt_s);
+            }
         });
     };
     return s;

@@ -2,7 +2,8 @@
 // the fixed step, samples its clip (lerp, slerp), composes the pose down the hierarchy
 // and keeps Skeleton::skinning = global * inverse_bind current, so the cloth can skin its
 // pinned particles without the mesh. Root motion (AnimationPlayer::in_place = false)
-// advances the Transform by the clip's travel each time the clip loops.
+// advances the Transform by the clip's travel each time the clip loops. Characters are
+// posed in parallel.
 #pragma once
 
 #include "engine/core/scheduler.hpp"

@@ -1,9 +1,10 @@
 // The cloth step: the cloth module's one entry in the scheduler (phase simulation).
 //
 // Each fixed step it gathers the garments (creating a solver for a garment that has none),
-// takes the substeps of the rule in systems/cloth/substeps.hpp (the largest need of all
-// garments, or ClothSolverSettings::fixed_substeps), and runs, in every substep, the three
-// cloth systems in the order of systems/cloth/garment_step.hpp:
+// takes each garment's substeps by the rule in systems/cloth/substeps.hpp (or
+// ClothSolverSettings::fixed_substeps), and runs the garments that need the same substeps
+// and rounds together (in parallel over garments), in every substep the three cloth
+// systems in the order of systems/cloth/garment_step.hpp:
 //   cloth_integration  (cloth_integration_system.hpp)  method §3.3-§3.5
 //   then rounds of
 //   cloth_constraint   (cloth_constraint_system.hpp)   method §4

@@ -2,6 +2,10 @@
 #include "systems/collider_system.hpp"
 
 #include <cmath>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "components/ellipsoid_collider.hpp"
 #include "components/skeleton.hpp"
@@ -53,11 +57,18 @@ System make_collider_system() {
     s.reads = components<Skeleton>();
     s.writes = components<EllipsoidCollider>();
     s.optional_reads = components<Transform>();
-    s.run = [](Registry& registry, const FrameContext& context) {
-        registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
-            const Skeleton* skeleton = registry.try_get<Skeleton>(c.character);
-            if (skeleton == nullptr) return;  // the character is gone
-            update_collider(c, *skeleton, registry.try_get<Transform>(c.character), context.fixed_dt_s);
+    // Colliders are independent (each task reads its character and writes one collider), so
+    // they move in parallel; the result does not depend on the thread count.
+    s.run = [colliders = std::vector<EllipsoidCollider*>{}](Registry& registry, const FrameContext& context) mutable {
+        colliders.clear();
+        registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) { colliders.push_back(&c); });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, colliders.size(), 16), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                EllipsoidCollider& c = *colliders[i];
+                const Skeleton* skeleton = registry.try_get<Skeleton>(c.character);
+                if (skeleton == nullptr) continue;  // the character is gone
+                update_collider(c, *skeleton, registry.try_get<Transform>(c.character), context.fixed_dt_s);
+            }
         });
     };
     return s;

@@ -3,7 +3,7 @@
 // keeps the previous world transform, and differentiates the centre over the fixed step
 // for the velocity and acceleration the body-driven force model needs, plus the frame's
 // angular velocity. The first update gives zero velocity and acceleration; the second
-// gives a velocity and still zero acceleration.
+// gives a velocity and still zero acceleration. Colliders are updated in parallel.
 #pragma once
 
 #include "engine/core/scheduler.hpp"

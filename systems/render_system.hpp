@@ -42,8 +42,8 @@ void draw_registry(Renderer& renderer, Registry& registry);
 /// over `dt_s` (snaps on the first call, when dt_s <= 0, or when the constant is 0).
 void update_follow_camera(Camera& camera, Registry& registry, double dt_s);
 
-/// Renders the registry's current state `frames` times through the render system's path
-/// (camera follow + draw + resolve); with `readback`, each frame is also read back to the
+/// Renders the registry's current state `frames` times through the render path (skinning
+/// system, then the render system: camera follow + draw + resolve); with `readback`, each frame is also read back to the
 /// CPU as an export would. Returns the wall time of each frame in ms, in order.
 [[nodiscard]] Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& registry, int frames,
                                                             bool readback = true);

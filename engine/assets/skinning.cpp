@@ -100,8 +100,22 @@ void skin_positions(const MeshAsset& mesh, std::span<const Affine3> skinning, co
 
 Affine3 rigid_part(const Affine3& transform) noexcept {
     Affine3 out = Affine3::Identity();
-    out.linear() = transform.rotation();  // polar decomposition (SVD)
     out.translation() = transform.translation();
+    // A rotation times a positive scale along its own axes (orthogonal columns: every bone
+    // of a rig without shear, a uniformly scaled Transform) has that rotation as its polar
+    // factor, and the normalised columns are it: no SVD. Anything else (shear, a mirror)
+    // takes the polar decomposition.
+    const Mat3 m = transform.linear();
+    const Vec3 lengths = m.colwise().norm();
+    if (lengths.minCoeff() > Real(1e-12)) {
+        const Mat3 q = m * lengths.cwiseInverse().asDiagonal();
+        const Mat3 gram = q.transpose() * q;
+        if ((gram - Mat3::Identity()).cwiseAbs().maxCoeff() < Real(1e-5) && q.determinant() > 0) {
+            out.linear() = q;
+            return out;
+        }
+    }
+    out.linear() = transform.rotation();  // polar decomposition (SVD)
     return out;
 }
 

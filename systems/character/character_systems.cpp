@@ -2,13 +2,11 @@
 
 #include "systems/animation_system.hpp"
 #include "systems/collider_system.hpp"
-#include "systems/skinning_system.hpp"
 
 namespace drape {
 
 void add_character_systems(Scheduler& scheduler) {
     scheduler.add(make_animation_system());
-    scheduler.add(make_skinning_system());
     scheduler.add(make_collider_system());
 }
 

@@ -63,7 +63,8 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
     advance_animation(player, skeleton, &transform, 0);  // pose at the start time
     SkinnedMesh& skin = registry.emplace<SkinnedMesh>(e);
     skin.mesh = asset->mesh;
-    skin_mesh(*skin.mesh, skeleton.skinning, transform.matrix(), skin.positions, skin.normals);
+    skin_mesh(*skin.mesh, skeleton.skinning, transform.matrix(), skin.positions, skin.normals);  // drawable at once
+    skin.skinned_vertices = static_cast<std::uint64_t>(skin.positions.cols());
 
     for (const EllipsoidShape& s : apply_overrides(body.ellipsoids, options.collider_overrides,
                                                    options.replace_fitted_colliders)) {

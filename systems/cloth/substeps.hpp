@@ -9,7 +9,7 @@
 //              (|v_e - v_anchor(c_e)| + |w_e - w_anchor| * r_max), so that no collider
 //              surface moves more than max_surface_travel through the cloth per substep;
 //   n = clamp(max(n_s, n_m), 1, max_substeps), or `fixed_substeps` when that is set.
-// The cloth systems run every garment with the largest need of all garments.
+// The cloth step runs every garment with its own need (systems/cloth_systems.hpp).
 // Walking adds a second substep when a thigh swings faster than ~2.4 m/s relative to the hips.
 #pragma once
 

@@ -12,6 +12,7 @@
 #include "engine/render/renderer.hpp"
 #include "game/sample_scene.hpp"
 #include "game/world.hpp"
+#include "systems/skinning_system.hpp"
 
 namespace drape {
 namespace {
@@ -95,6 +96,37 @@ TEST(SampleSceneRender, SkirtAndAvatarAppearWhereTheCameraPutsThem) {
     // Far above the avatar there is sky: bluer than red.
     const ScreenPoint top{static_cast<float>(image->width) / 2, 4, 0};
     EXPECT_GT(share_around(*image, top, 3, [](Rgb c) { return c.b > c.r; }), 0.9);
+}
+
+}  // namespace
+}  // namespace drape
+
+namespace drape {
+namespace {
+
+TEST(SampleSceneRender, MeshIsSkinnedOncePerDrawnFrameNotPerStep) {
+    WorldOptions options;
+    options.render = true;
+    options.width = 320;
+    options.height = 180;
+    auto world = build_world(sample_scene(), options);
+    ASSERT_TRUE(world) << world.error().message;
+    const SkinnedMesh& skin = world->registry.get<SkinnedMesh>(world->characters[0]);
+    const std::uint64_t vertices = skin.mesh->vertex_count();
+    const std::uint64_t at_start = skin.skinned_vertices;
+    // Frames of two fixed steps each: the body is posed twice, skinned once.
+    constexpr int frames = 5;
+    for (int frame = 0; frame < frames; ++frame) {
+        auto report = step_world(*world, 2.0 / 60.0);
+        ASSERT_TRUE(report);
+        EXPECT_EQ(report->steps, 2);
+    }
+    EXPECT_EQ(skin.skinned_vertices - at_start, frames * vertices);
+    EXPECT_EQ(world->scheduler.system_names(Phase::render), (std::vector<std::string>{"skinning", "render"}));
+    // The drawn body is the current pose: the skinning matrices applied now give the same vertices.
+    const Matrix3X drawn = skin.positions;
+    skin_characters(world->registry);
+    EXPECT_TRUE(drawn == skin.positions);
 }
 
 }  // namespace
