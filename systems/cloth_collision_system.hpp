@@ -1,8 +1,7 @@
 // Cloth collision system (method §5): every garment against the ellipsoids of its body,
-// with candidate lists and temporal coherence. In each of the constraint system's rounds the
-// integrated particles (and, in the simplified model, the chords layer 2 is placed on) are
-// moved out, positions only; after the rounds, the simplified model's layer 2, then the
-// non-finite check. Timed as "cloth_collision".
+// with candidate lists and temporal coherence. In each of the constraint system's rounds
+// every free particle (both layers) is moved out, positions only, and its push recorded for
+// the velocities; after the rounds, the non-finite check. Timed as "cloth_collision".
 #pragma once
 
 #include "engine/core/registry.hpp"

@@ -1,7 +1,8 @@
-// Cloth constraint system (method §4): Gauss-Seidel rounds of tethers, springs in
-// compliance form and Provot's strain limit (§4.1), alternating with the collision system's
-// rounds; then the substep's velocities and, in the simplified model, the weft (layer 2)
-// placed from layer 1 (§4.2). Timed as "cloth_constraint".
+// Cloth constraint system (method §4): Gauss-Seidel rounds of springs in compliance form
+// with Provot's strain limit (§4.1), then tethers, alternating with the collision system's
+// rounds; in the simplified model the first round places the weft (layer 2) from layer 1
+// (§4.2). After the rounds: the substep's velocities from its moves and, in the simplified
+// model, the weft's places recorded for the next substep. Timed as "cloth_constraint".
 #pragma once
 
 #include "systems/cloth/garment_batch.hpp"

@@ -1,6 +1,7 @@
-// Cloth integration system (method §3.3-§3.5): the body-driven force of paper eq. 2 and
-// symplectic Euler on the integrated particles (simplified model: layer 1; classic: all),
-// then the fitting-zone pins, relative to the anchor's frame. First of the three cloth systems
+// Cloth integration system (method §3.3-§3.5): the explicit prediction of paper eq. 2's
+// body-driven, gravity and drag forces in the anchor's frame on the integrated particles
+// (simplified model: layer 1; classic: all; the springs act in the constraint rounds),
+// then the fitting-zone pins. First of the three cloth systems
 // in every substep; the cloth
 // step (cloth_systems.hpp) runs it and times it as "cloth_integration".
 #pragma once

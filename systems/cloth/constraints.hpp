@@ -2,15 +2,15 @@
 // solved by Gauss-Seidel rounds after the explicit prediction of integrator.hpp.
 //
 // Step order of one round (cloth constraint system; docs/cloth.md "Solver"):
-//   1. Tethers: a free particle no farther from the pinned particle at the top of its warp
-//      line than the rest length of the line between them (long-range attachments, as Jolt
-//      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
-//      line's weight up to its pin, the tether does it in one).
-//   2. Springs, set by set in list order (warp springs run from the pins outward): the
+//   1. Springs, set by set in list order (warp springs run from the pins outward): the
 //      stretch spring of stiffness k as an XPBD constraint of compliance 1/k (the implicit
 //      response of the same Hooke spring, stable at any stiffness), then Provot's limit: a
 //      spring still longer than (1 + limit) x rest has its ends moved back to the limit,
 //      shared by inverse mass (a pinned end stays).
+//   2. Tethers: a free particle no farther from the pinned particle at the top of its warp
+//      line than the rest length of the line between them (long-range attachments, as Jolt
+//      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
+//      line's weight up to its pin, the tether does it in one).
 // Positions only: the velocities follow from the whole substep's move afterwards
 // (garment_step.hpp), as Provot's velocities follow his corrections.
 #pragma once
