@@ -15,7 +15,7 @@
 #include "engine/core/registry.hpp"
 #include "engine/core/scheduler.hpp"
 #include "game/asset_paths.hpp"
-#include "systems/character/character_systems.hpp"
+#include "systems/character_systems.hpp"
 #include "systems/character/spawn.hpp"
 #include "systems/cloth_systems.hpp"
 #include "systems/cloth/garment_builder.hpp"

@@ -16,7 +16,7 @@
 #include "game/scene_file.hpp"
 #include "game/scene_garment_parameters.hpp"
 #include "systems/character/character_body.hpp"
-#include "systems/character/character_systems.hpp"
+#include "systems/character_systems.hpp"
 #include "systems/character/spawn.hpp"
 #include "systems/cloth/garment_builder.hpp"
 #include "systems/cloth/garment_config.hpp"

@@ -1,7 +1,6 @@
 // Animation system: see animation_system.hpp.
 #include "systems/animation_system.hpp"
 
-#include <cmath>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -10,30 +9,9 @@
 #include "components/animation_player.hpp"
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
-#include "systems/character/pose.hpp"
+#include "systems/character/animation.hpp"
 
 namespace drape {
-
-void advance_animation(AnimationPlayer& player, Skeleton& skeleton, Transform* transform, double dt_s) {
-    if (!skeleton.asset) return;
-    const SkeletonAsset& asset = *skeleton.asset;
-    if (player.clip) {
-        if (player.playing && std::isfinite(player.speed) && player.clip->duration_s > 0) {
-            const ClipTime t = wrap_clip_time(player.time_s + dt_s * player.speed, player.clip->duration_s, player.loop);
-            if (t.cycles != 0 && !player.in_place && transform != nullptr) {
-                // The pose jumps back by one cycle's travel; the character moves forward by it.
-                transform->position += transform->rotation * (transform->scale * Real(t.cycles) * player.clip->travel_m);
-            }
-            player.cycles += t.cycles;
-            player.time_s = t.time_s;
-        }
-        sample_clip(*player.clip, asset, player.time_s, player.in_place, skeleton.local);  // a one-key clip is a pose
-    } else {
-        rest_pose(asset, skeleton.local);
-    }
-    compose_pose(asset, skeleton.local, skeleton.global);
-    skinning_matrices(asset, skeleton.global, skeleton.skinning);
-}
 
 System make_animation_system() {
     System s;

@@ -10,13 +10,6 @@
 
 namespace drape {
 
-[[nodiscard]] System make_animation_system();
-
-struct AnimationPlayer;
-struct Skeleton;
-struct Transform;
-
-/// One entity's update, as the system runs it (tests call it without a scheduler).
-void advance_animation(AnimationPlayer& player, Skeleton& skeleton, Transform* transform, double dt_s);
+[[nodiscard]] System make_animation_system();  ///< advance_animation (systems/character/animation.hpp) for every character.
 
 }  // namespace drape

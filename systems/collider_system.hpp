@@ -10,13 +10,6 @@
 
 namespace drape {
 
-struct EllipsoidCollider;
-struct Skeleton;
-struct Transform;
-
-[[nodiscard]] System make_collider_system();
-
-/// One collider's update from its character's pose (tests call it without a scheduler).
-void update_collider(EllipsoidCollider& collider, const Skeleton& skeleton, const Transform* transform, double dt_s);
+[[nodiscard]] System make_collider_system();  ///< update_collider (systems/character/colliders.hpp) for every collider.
 
 }  // namespace drape

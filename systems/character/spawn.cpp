@@ -9,10 +9,10 @@
 #include "components/skeleton.hpp"
 #include "components/skinned_mesh.hpp"
 #include "engine/assets/character_import.hpp"
-#include "systems/animation_system.hpp"
+#include "systems/character/animation.hpp"
+#include "systems/character/colliders.hpp"
 #include "systems/character/ellipsoid_fit.hpp"
 #include "systems/character/pose.hpp"
-#include "systems/collider_system.hpp"
 
 namespace drape {
 

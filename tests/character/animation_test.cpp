@@ -6,7 +6,7 @@
 #include "components/animation_player.hpp"
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
-#include "systems/animation_system.hpp"
+#include "systems/character/animation.hpp"
 #include "systems/character/pose.hpp"
 
 namespace drape {

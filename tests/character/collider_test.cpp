@@ -13,9 +13,10 @@
 #include "engine/assets/character_import.hpp"
 #include "engine/core/scheduler.hpp"
 #include "systems/character/character_body.hpp"
-#include "systems/character/character_systems.hpp"
+#include "systems/character/colliders.hpp"
 #include "systems/character/pose.hpp"
 #include "systems/character/spawn.hpp"
+#include "systems/character_systems.hpp"
 #include "systems/collider_system.hpp"
 #include "tests/character/test_character_file.hpp"
 

@@ -1,4 +1,4 @@
-#include "systems/character/character_systems.hpp"
+#include "systems/character_systems.hpp"
 
 #include "systems/animation_system.hpp"
 #include "systems/collider_system.hpp"
