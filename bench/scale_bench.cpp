@@ -39,7 +39,7 @@ struct Point {
     double body_ms = 0, cloth_ms = 0, collide_ms = 0, garment_ms = 0, frame_ms = 0;
     double substeps = 0;
     double animation_ms = 0, colliders_ms = 0;
-    std::vector<std::pair<std::string, double>> systems;  ///< Every system and section, ms per frame, profile order.
+    std::vector<std::pair<std::string, double>> systems{};  ///< Every system and section, ms per frame, profile order.
 
     [[nodiscard]] double body_us_per_walker() const { return walkers ? 1000.0 * body_ms / walkers : 0; }
 

@@ -104,8 +104,11 @@ TEST(Crowd, HeadlessWorldSkinsNoMeshVertex) {
     EXPECT_FALSE(world->registry.get<Skeleton>(world->characters[0]).global.at(1).isApprox(first_pose, 1e-6f));
     EXPECT_FALSE(has_nonfinite(*world));
     const RunStats stats = run_stats(*world);
-    for (const SystemStats& s : stats.systems)
-        if (s.name == "animation" || s.name == "colliders") EXPECT_EQ(s.runs, 30u) << s.name;
+    for (const SystemStats& s : stats.systems) {
+        if (s.name == "animation" || s.name == "colliders") {
+            EXPECT_EQ(s.runs, 30u) << s.name;
+        }
+    }
 }
 
 TEST(Crowd, OneOrTwoThreadsGiveIdenticalBytes) {
