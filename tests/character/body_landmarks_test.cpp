@@ -3,12 +3,12 @@
 // legs hang from another bone than the one named Hips) and a non-humanoid.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <string_view>
 
 #include "engine/assets/character_import.hpp"
 #include "systems/character/body_landmarks.hpp"
+#include "tests/shared_assets.hpp"
 
 namespace drape {
 namespace {
@@ -21,9 +21,10 @@ std::shared_ptr<const CharacterAsset> load(const fs::path& file) {
     return c ? *c : nullptr;
 }
 
+// Present, or (one of several files) skipped with a failure under CI.
 bool present_or_skip(const fs::path& file) {
     if (fs::exists(file)) return true;
-    if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true") ADD_FAILURE() << file << " absent under CI";
+    if (test::under_ci()) ADD_FAILURE() << file << " is absent under CI";
     return false;
 }
 
@@ -89,7 +90,7 @@ TEST(BodyLandmarks, SharedHumanoidsByTopology) {
 
 TEST(BodyLandmarks, ANonHumanoidIsAnErrorNamingTheFile) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/rigged_simple/RiggedSimple.glb";
-    if (!present_or_skip(file)) GTEST_SKIP() << file << " absent";
+    DRAPE_REQUIRE_SHARED(file);
     const auto c = load(file);
     ASSERT_TRUE(c);
     const auto l = find_body_landmarks(*c);

@@ -3,11 +3,10 @@
 // live outside the project; without them the tests skip and say so, except under CI.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <string_view>
 
 #include "engine/assets/character_import.hpp"
+#include "tests/shared_assets.hpp"
 #include "systems/character/character_body.hpp"
 #include "systems/character/pose.hpp"
 
@@ -16,14 +15,7 @@ namespace {
 
 std::filesystem::path shared(const char* relative) { return std::filesystem::path(DRAPE_SHARED_ASSETS) / relative; }
 
-// Absent on a clone without ../shared: skipped there, but a failure under CI (CI=true),
-// where the characters must be present.
-#define REQUIRE_SHARED(path)                                                                             \
-    if (!std::filesystem::exists(path)) {                                                                \
-        if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true")                    \
-            FAIL() << "shared test characters absent under CI: " << (path);                             \
-        GTEST_SKIP() << "shared test characters absent: " << (path);                                     \
-    }
+#define REQUIRE_SHARED(path) DRAPE_REQUIRE_SHARED(path)
 
 struct Expect {
     const char* file;

@@ -4,13 +4,12 @@
 // inside an ellipsoid, and nothing may go non-finite.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <string_view>
 
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
 #include "game/world.hpp"
+#include "tests/shared_assets.hpp"
 
 namespace drape {
 namespace {
@@ -44,11 +43,7 @@ int particles_inside(World& world, const Garment& g) {
 
 void dress_and_walk(const Character& c, GarmentType type) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
-    if (!fs::exists(file)) {
-        // Optional on a clone without ../shared; under CI (CI=true) they must be there.
-        if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true") FAIL() << file << " is absent under CI";
-        GTEST_SKIP() << file << " is absent (the shared third-party characters are optional)";
-    }
+    DRAPE_REQUIRE_SHARED(file);
     SceneDescription scene;
     scene.characters.emplace_back();
     scene.characters[0].file = file;

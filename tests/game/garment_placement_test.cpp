@@ -4,9 +4,7 @@
 // the pinned points stay outside the ellipsoids.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <string_view>
 
 #include "components/body_landmarks.hpp"
 #include "components/garment.hpp"
@@ -16,6 +14,7 @@
 #include "game/world.hpp"
 #include "systems/character/body_landmarks.hpp"
 #include "systems/cloth/garment_quality.hpp"
+#include "tests/shared_assets.hpp"
 
 namespace drape {
 namespace {
@@ -83,10 +82,7 @@ TEST(GarmentPlacement, ASetFractionOverridesTheLandmark) {
 
 TEST(GarmentPlacement, SkirtAtTheWaistOfAThirdPartyCharacter) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/female_alternative/Female_Alternative.fbx";
-    if (!fs::exists(file)) {
-        if (const char* ci = std::getenv("CI"); ci && std::string_view(ci) == "true") FAIL() << file << " absent under CI";
-        GTEST_SKIP() << file << " absent (the shared third-party characters are optional)";
-    }
+    DRAPE_REQUIRE_SHARED(file);
     const Placed skirt = place(file, GarmentType::skirt);
     expect_at(skirt.ring_y, skirt.waist_y);
 }
