@@ -249,9 +249,8 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     if (landmarks && pose && transform && !pose->global.empty()) {
         const BodyPoint& at = s.ring_at == RingPlace::waist ? landmarks->waist.center : landmarks->under_arms;
         const Vec3 ring = landmark_world(at, *pose, *transform);
-        const Vec3 floor = transform->matrix() * Vec3(ring.x(), landmarks->floor_m, ring.z());
         height = landmarks->height_m * transform->scale;
-        bottom = floor.y();
+        bottom = (transform->matrix() * Vec3(0, landmarks->floor_m, 0)).y();  // an upright character
         axis = ring;
         // Under the arms: a little lower, so that the arms' skin clears the cloth.
         landmark_y = ring.y() - (s.ring_at == RingPlace::under_arms ? Real(0.02) * height : Real(0));
