@@ -63,7 +63,6 @@ struct Fabric {
     std::uint32_t weft_stride = 1;          ///< Every weft_stride-th line is layer 1.
     bool closed = false;                    ///< The weft wraps around (skirt, dress).
     std::uint32_t layer1_count = 0;         ///< Particles [0, layer1_count) are layer 1.
-    Real layer1_mass_scale = 1;             ///< Particles a layer-1 particle stands for.
 
     std::vector<std::uint32_t> grid;        ///< Particle index of (line, row): grid[line * m + row].
     std::vector<std::uint8_t> layer;        ///< 1 or 2 per particle.
@@ -80,18 +79,12 @@ struct Fabric {
     SpringPhase shear;       ///< Classic only: grid diagonals.
     SpringPhase bend;        ///< Classic only: every second particle, warp and weft.
 
-    // Weft placement (method §4.2), one entry per layer-2 particle.
+    // Weft carriage (method §4.2), one entry per layer-2 particle.
     std::vector<std::uint32_t> weft_particle;  ///< The layer-2 particle.
     std::vector<std::uint32_t> weft_left;      ///< Its layer-1 neighbour before it along the weft.
     std::vector<std::uint32_t> weft_right;     ///< Its layer-1 neighbour after it.
     std::vector<Real> weft_t;                  ///< Its place on the chord from left to right, (0, 1): the rest length
                                                ///< of the weft segments before it over that of the whole chord.
-    std::vector<Real> weft_chord_rest_m;       ///< Rest length of the weft segments from left to right.
-    std::vector<Real> weft_rest_m;             ///< The shorter rest length of its two weft segments.
-    std::vector<std::uint32_t> weft_above;     ///< The particle before it on its warp line (nearer the pins), or UINT32_MAX.
-    std::vector<Real> weft_above_rest_m;       ///< Rest length of that warp spring.
-    // Normal stencil of each layer-1 particle: n = (x[up] - x[down]) x (x[next] - x[prev]).
-    std::vector<std::uint32_t> normal_up, normal_down, normal_prev, normal_next;
 
     [[nodiscard]] std::size_t particle_count() const noexcept { return layer.size(); }
 };

@@ -104,13 +104,17 @@ void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& w, Real h, Re
     }
 }
 
-Tethers build_tethers(const Fabric& f, const VectorX& w, std::uint32_t count) {
+VectorX warp_rest_above(const Fabric& f) {
+    VectorX above = VectorX::Zero(static_cast<Eigen::Index>(f.particle_count()));
+    for (const SpringPhase* phase : {&f.warp1, &f.warp2})
+        for (std::size_t s = 0; s < phase->size(); ++s) above[phase->b[s]] = phase->rest_m[s];
+    return above;
+}
+
+Tethers build_tethers(const Fabric& f, const VectorX& w) {
     Tethers t;
     const std::uint32_t m = f.particles_per_line;
-    // Rest lengths along each line from the warp springs (listed line by line, pins outward).
-    std::vector<Real> down(f.particle_count(), 0);  // rest length of the spring above each particle
-    for (const SpringPhase* phase : {&f.warp1, &f.warp2})
-        for (std::size_t s = 0; s < phase->size(); ++s) down[phase->b[s]] = phase->rest_m[s];
+    const VectorX above = warp_rest_above(f);
     for (std::uint32_t line = 0; line < f.warp_lines; ++line) {
         std::uint32_t anchor = std::numeric_limits<std::uint32_t>::max();
         Real along = 0;
@@ -121,8 +125,8 @@ Tethers build_tethers(const Fabric& f, const VectorX& w, std::uint32_t count) {
                 along = 0;
                 continue;
             }
-            along += down[p];
-            if (anchor == std::numeric_limits<std::uint32_t>::max() || p >= count) continue;
+            along += above[p];
+            if (anchor == std::numeric_limits<std::uint32_t>::max()) continue;
             t.particle.push_back(p);
             t.anchor.push_back(anchor);
             t.length_m.push_back(along);
@@ -146,6 +150,26 @@ void solve_tethers(const Tethers& t, Matrix3XRows& x) {
         x1[p] = x1[q] + d1 * scale;
         x2[p] = x2[q] + d2 * scale;
     }
+}
+
+void limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real limit, Matrix3X& x,
+                      Matrix3X& moves) {
+    moves.setZero();
+    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+    const Real scale = 1 + limit;
+    // Row after row from the fitting zone down, every line of the row in turn: the particle
+    // above has its final place when its neighbour below is limited.
+    for (std::uint32_t row = 1; row < m; ++row)
+        for (std::uint32_t line = 0; line < n; ++line) {
+            const std::uint32_t p = f.grid[line * m + row], q = f.grid[line * m + row - 1];
+            if (w[p] == 0) continue;
+            const Vec3 d = x.col(p) - x.col(q);
+            const Real length_sq = d.squaredNorm(), longest = scale * rest_above[p];
+            if (length_sq <= longest * longest) continue;
+            const Vec3 move = d * (longest / std::sqrt(length_sq) - 1);
+            x.col(p) += move;
+            moves.col(p) = move;
+        }
 }
 
 Real max_strain(const SpringPhase& springs, const Matrix3X& x) {

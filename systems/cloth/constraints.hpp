@@ -11,6 +11,8 @@
 //      line than the rest length of the line between them (long-range attachments, as Jolt
 //      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
 //      line's weight up to its pin, the tether does it in one).
+// After the rounds, once per substep, limit_warp_lines holds every warp spring within the
+// limit by a one-sided pass from the pins down (follow the leader).
 // Positions only: the velocities follow from the whole substep's move afterwards
 // (garment_step.hpp), as Provot's velocities follow his corrections.
 #pragma once
@@ -55,19 +57,31 @@ struct SpringSet {
 /// held one row per coordinate. `inv_mass` 0 = does not move.
 void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
 
-/// Long-range attachments (step 1): one per free particle below a pinned one on its line.
+/// Long-range attachments (step 2): one per free particle below a pinned one on its line.
 struct Tethers {
     std::vector<std::uint32_t> particle;  ///< The free particle.
     std::vector<std::uint32_t> anchor;    ///< The pinned particle above it on its warp line.
     std::vector<Real> length_m;           ///< Rest length of the line between them.
 };
 
-/// Tethers of the free particles among [0, count) (the integrated ones), from the nearest
-/// pinned particle above each on its warp line; none for a line without a pinned particle.
-[[nodiscard]] Tethers build_tethers(const Fabric& fabric, const VectorX& inv_mass, std::uint32_t count);
+/// Per particle: rest length of the warp spring to the particle above it on its line (0 in
+/// the first row).
+[[nodiscard]] VectorX warp_rest_above(const Fabric& fabric);
 
-/// One pass over the tethers (step 1).
+/// Tethers of every free particle, layer 2 included, from the nearest pinned particle above
+/// it on its warp line; none for a line without a pinned particle.
+[[nodiscard]] Tethers build_tethers(const Fabric& fabric, const VectorX& inv_mass);
+
+/// One pass over the tethers (step 2).
 void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
+
+/// After the rounds: Provot's limit along the warp, one-sided (method §4.1: the end nearer
+/// the pins stays, as a pinned end does). Row after row from the fitting zone down, a free
+/// particle farther than (1 + limit) x rest from the particle above it on its line is moved
+/// back onto that sphere, so no warp spring is over the limit afterwards. `moves` receives
+/// each particle's move (zero for the rest).
+void limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real limit,
+                      Matrix3X& x, Matrix3X& moves);
 
 /// Largest length / rest - 1 over `springs` (0 when none is stretched).
 [[nodiscard]] Real max_strain(const SpringPhase& springs, const Matrix3X& x);

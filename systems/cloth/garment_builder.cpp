@@ -460,26 +460,6 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
                 segments += rest(k, row, (k + 1) % n, row);
             }
             t->weft_t.push_back(before / segments);
-            t->weft_chord_rest_m.push_back(segments);
-            t->weft_rest_m.push_back(std::min(rest((line + n - 1) % n, row, line, row), rest(line, row, (line + 1) % n, row)));
-            t->weft_above.push_back(row > 0 ? at(line, row - 1) : std::numeric_limits<std::uint32_t>::max());
-            t->weft_above_rest_m.push_back(row > 0 ? rest(line, row - 1, line, row) : Real(0));
-        }
-    }
-    // Normal stencil of every layer-1 particle, in particle order.
-    t->normal_up.resize(t->layer1_count);
-    t->normal_down.resize(t->layer1_count);
-    t->normal_prev.resize(t->layer1_count);
-    t->normal_next.resize(t->layer1_count);
-    for (std::uint32_t line = 0; line < n; line += stride) {
-        const std::uint32_t prev = closed ? (line + n - stride) % n : (line >= stride ? line - stride : line);
-        const std::uint32_t nxt = closed ? (line + stride) % n : (line + stride < n ? line + stride : line);
-        for (std::uint32_t row = 0; row < m; ++row) {
-            const std::uint32_t i = at(line, row);
-            t->normal_up[i] = at(line, row > 0 ? row - 1 : row);
-            t->normal_down[i] = at(line, row + 1 < m ? row + 1 : row);
-            t->normal_prev[i] = at(prev, row);
-            t->normal_next[i] = at(nxt, row);
         }
     }
     // Render triangles, counter-clockwise seen from the side the normals point to.

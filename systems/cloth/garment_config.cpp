@@ -47,7 +47,6 @@ Result<void> set_garment_state(Registry& registry, Entity garment, const Matrix3
         // Last substep's contacts and the lists' references were of other places.
         std::fill(s->last_collided.begin(), s->last_collided.end(), 0);
         s->lists.valid = false;
-        s->weft_offsets_valid = false;
     }
     return {};
 }

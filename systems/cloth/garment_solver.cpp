@@ -11,7 +11,6 @@ namespace drape {
 void invalidate(GarmentSolver& s) {
     s.configured = false;
     s.lists.valid = false;
-    s.weft_offsets_valid = false;
 }
 
 namespace {
@@ -87,7 +86,8 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
             s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true));
         }
-        s.tethers = build_tethers(t, state.inv_mass, static_cast<std::uint32_t>(s.integrated));
+        s.tethers = build_tethers(t, state.inv_mass);
+        s.warp_rest_above = warp_rest_above(t);
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;
         s.built_fabric = &t;
@@ -95,8 +95,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.configured = true;
     }
     if (s.force.cols() != n) s.force = Matrix3X::Zero(3, n);
-    if (s.normals.cols() != static_cast<Eigen::Index>(t.layer1_count)) s.normals = Matrix3X::Zero(3, t.layer1_count);
-    if (s.plane_normal.cols() != n) s.plane_normal = Matrix3X::Zero(3, n);
+    if (s.warp_moves.cols() != n) s.warp_moves = Matrix3X::Zero(3, n);
     if (s.movable.size() != static_cast<std::size_t>(n)) {
         s.movable.resize(static_cast<std::size_t>(n));
         for (Eigen::Index i = 0; i < n; ++i) s.movable[static_cast<std::size_t>(i)] = state.inv_mass[i] != 0;

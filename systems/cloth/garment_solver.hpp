@@ -51,10 +51,12 @@ struct GarmentSolver {
     // Derived from the fabric, the pins and the configuration (prepare_solver).
     Eigen::Index integrated = 0;             ///< Particles [0, integrated) are integrated (simplified: layer 1).
     VectorX inv_mass;                        ///< Of every particle as the solver moves it: a layer-1 particle of the
-                                             ///< simplified model carries the mass of the weft particles placed from it.
+                                             ///< simplified model carries the mass of the weft particles it carries.
     VectorX drag_N_s_m;                      ///< eq. 2's k per particle, with the same shares.
     std::vector<SpringSet> springs;          ///< The springs the model solves, in order.
     Tethers tethers;                         ///< Long-range attachments from the pins.
+    VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
+                                             ///< on its line (0 in the first row).
     Real drag_step_s = 0;                    ///< Largest stable step of the explicit drag.
 
     std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep, one per GarmentBody::colliders.
@@ -63,8 +65,6 @@ struct GarmentSolver {
 
     Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
     std::vector<EllipsoidFrame> pin_frames;  ///< Scratch: the colliders at the end of the fixed step, for the pins.
-    Matrix2X weft_offsets;                   ///< Simplified: each layer-2 particle's place in its plane (weft.hpp).
-    bool weft_offsets_valid = false;         ///< False: taken from the positions at the next step.
     Vec3 anchor_velocity_before = Vec3::Zero();      ///< The anchor's V when the velocities were last written.
     Vec3 anchor_angular_before = Vec3::Zero();       ///< Its W then.
     bool anchor_known = false;               ///< False: no step yet (the anchor's motion so far counts as none).
@@ -75,8 +75,7 @@ struct GarmentSolver {
     Matrix3XRows x_rows;                     ///< Positions one row per coordinate, for the constraint rounds.
     Matrix3X push;                           ///< Per particle: the collision rounds' push-outs this substep.
     std::vector<std::uint64_t> contacts;     ///< Per particle: ellipsoids it touched in this substep's rounds.
-    Matrix3X normals;                        ///< Layer-1 normals for weft placement.
-    Matrix3X plane_normal;                   ///< Per particle: its weft plane's unit normal (layer 2), else zero.
+    Matrix3X warp_moves;                     ///< Per particle: the warp limit's move this substep.
     std::vector<std::uint8_t> movable;       ///< Per particle: 1 unless pinned.
     Matrix3X force;                          ///< Scratch of 3 x particles.
 };

@@ -16,6 +16,10 @@
 
 namespace drape {
 
+// Dynamic follow-the-leader's damping s_damping (Müller et al. 2012): the share of a
+// follower's warp-limit move that its leader's velocity gives back.
+constexpr Real leader_damping = Real(0.9);
+
 ClothSubstep make_substep(int index, int count, double fixed_dt_s) noexcept {
     return ClothSubstep{index, count, fixed_dt_s, fixed_dt_s / count};
 }
@@ -67,6 +71,8 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
     const Vec3 gravity(0, -standard_gravity_m_s2, 0);
     predict_particles(state.x, state.v, s.inv_mass, s.drag_N_s_m, s.integrated, motion, g.config.inertia, gravity,
                       static_cast<Real>(sub.h_s));
+    // §4.2: layer 2 is carried by the layer 1 it hangs between (weft.hpp).
+    if (g.config.model == ClothModel::simplified) carry_weft(*g.fabric, state.inv_mass, s.x_start, state.x);
     s.anchor_velocity_before = motion.velocity_m_s;
     s.anchor_angular_before = motion.angular_velocity_rad_s;
     s.anchor_known = true;
@@ -80,23 +86,11 @@ void prepare_collision(const Registry& registry, Garment& g, GarmentSolver& s, c
     update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
 }
 
-void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int round) {
+void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int) {
     prepare_solver(g, s);
-    const Fabric& t = *g.fabric;
     Matrix3X& x = g.state.x;
     const Real h = static_cast<Real>(sub.h_s);
     const Real limit = g.config.material.strain_limit;
-    if (round == 0 && g.config.model == ClothModel::simplified) {
-        // §4.2: layer 2 placed in its planes from layer 1 (weft.hpp). Its places were taken
-        // at the end of the last substep, with the layer-1 positions of then.
-        if (!s.weft_offsets_valid) {
-            compute_layer1_normals(t, s.x_start, s.normals);
-            record_weft_offsets(t, s.normals, s.x_start, s.weft_offsets);
-            s.weft_offsets_valid = true;
-        }
-        compute_layer1_normals(t, x, s.normals);
-        place_weft(t, s.normals, g.state.inv_mass, s.weft_offsets, x, s.plane_normal);
-    }
     s.x_rows = x;  // one row per coordinate: the strips run in vector lanes
     for (SpringSet& set : s.springs) solve_springs(set, s.x_rows, s.inv_mass, h, limit);
     solve_tethers(s.tethers, s.x_rows);
@@ -115,49 +109,9 @@ void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSub
     s.push += x - s.x_round;
 }
 
-void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep&) {
     prepare_solver(g, s);
-    Matrix3X& x = g.state.x;
-    Matrix3X& v = g.state.v;
-    const Real h = static_cast<Real>(sub.h_s);
-    const Real friction = g.config.material.friction;
-    // Every free particle, layer 2 too: its placement's velocity (weft.hpp) followed by the
-    // rounds' moves, as Provot's velocities follow his corrections.
-    for (Eigen::Index p = 0; p < x.cols(); ++p) {
-        if (s.inv_mass[p] == 0) continue;  // pins: their velocity is the skin's
-        const Vec3 moved = (x.col(p) - s.x_start.col(p)) / h;
-        const std::uint64_t touched = s.contacts[static_cast<std::size_t>(p)];
-        if (touched == 0) {
-            v.col(p) = moved;
-            continue;
-        }
-        // In contact: the motion along the surface is the particle's (it slides, slowed by
-        // Coulomb friction); across it, the push-outs are not motion: it keeps the normal
-        // velocity it had without them where that leaves the surface, else the surface's.
-        const Vec3 unpushed = moved - s.push.col(p) / h;
-        Vec3 vp = moved;
-        for (std::uint64_t bits = touched; bits != 0; bits &= bits - 1) {
-            const EllipsoidFrame& f = s.frames[static_cast<std::size_t>(std::countr_zero(bits))];
-            if (!f.active) continue;
-            const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, x.col(p))).normalized();
-            if (!normal.allFinite()) continue;
-            const Vec3 surface = body_velocity_at(f, x.col(p));
-            const Real away = (unpushed - surface).dot(normal);
-            Vec3 tangential = (vp - surface) - (vp - surface).dot(normal) * normal;
-            if (away < 0) {
-                const Real t_len = tangential.norm();
-                if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
-            }
-            vp = surface + tangential + std::max(away, Real(0)) * normal;
-        }
-        v.col(p) = vp;
-    }
-    if (g.config.model == ClothModel::simplified) {
-        // §4.2 item 1: layer 2's places in its planes where the rounds left it.
-        compute_layer1_normals(*g.fabric, x, s.normals);
-        record_weft_offsets(*g.fabric, s.normals, x, s.weft_offsets);
-        s.weft_offsets_valid = true;
-    }
+    limit_warp_lines(*g.fabric, s.warp_rest_above, s.inv_mass, g.config.material.strain_limit, g.state.x, s.warp_moves);
 }
 
 std::uint64_t count_non_finite(const Garment& g) {
@@ -165,12 +119,66 @@ std::uint64_t count_non_finite(const Garment& g) {
 }
 
 namespace {
+
+// The velocity after the substep of every free particle, layer 2 too: its move over the
+// substep, as Provot's velocities follow his corrections, with two parts that are not motion:
+// - the warp limit's move of the particle below it on its line (follow the leader with the
+//   damping of dynamic follow-the-leader: the leader feels most of what it did to the
+//   follower, which a one-sided move would otherwise add as energy);
+// - where it touched an ellipsoid, the push-outs: across the surface it keeps the normal
+//   velocity it had without them where that leaves the surface, else the surface's (no
+//   approach, method §5); along it, the motion relative to the surface slowed by Coulomb
+//   friction (shortened by `friction` x the approach removed, never reversed).
+void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    const Fabric& t = *g.fabric;
+    Matrix3X& x = g.state.x;
+    Matrix3X& v = g.state.v;
+    const Real inv_h = static_cast<Real>(1 / sub.h_s);
+    const Real friction = g.config.material.friction;
+    const std::uint32_t m = t.particles_per_line;
+    for (std::uint32_t line = 0; line < t.warp_lines; ++line)
+        for (std::uint32_t row = 0; row < m; ++row) {
+            const std::uint32_t p = t.grid[line * m + row];
+            if (s.inv_mass[p] == 0) continue;  // pins: their velocity is the skin's
+            Vec3 moved = (x.col(p) - s.x_start.col(p)) * inv_h;
+            if (row + 1 < m) moved -= leader_damping * inv_h * s.warp_moves.col(t.grid[line * m + row + 1]);
+            const std::uint64_t touched = s.contacts[p];
+            if (touched == 0) {
+                v.col(p) = moved;
+                continue;
+            }
+            const Vec3 unpushed = moved - s.push.col(p) * inv_h;
+            Vec3 vp = moved;
+            for (std::uint64_t bits = touched; bits != 0; bits &= bits - 1) {
+                const EllipsoidFrame& f = s.frames[static_cast<std::size_t>(std::countr_zero(bits))];
+                if (!f.active) continue;
+                const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, x.col(p))).normalized();
+                if (!normal.allFinite()) continue;
+                const Vec3 surface = body_velocity_at(f, x.col(p));
+                const Real away = (unpushed - surface).dot(normal);
+                Vec3 tangential = (vp - surface) - (vp - surface).dot(normal) * normal;
+                if (away < 0) {
+                    const Real t_len = tangential.norm();
+                    if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
+                }
+                vp = surface + tangential + std::max(away, Real(0)) * normal;
+            }
+            v.col(p) = vp;
+        }
+}
+
 // Every value finite, in one vectorised pass: x * 0 is 0 for a finite x and NaN for an
 // infinity or a NaN, and the sum carries the NaN (Eigen's allFinite() tests value by value).
 bool all_finite(const Matrix3X& m) { return !std::isnan((m.array() * 0).sum()); }
+
 }  // namespace
 
-void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep&) {
+void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    prepare_solver(g, s);
+    // The warp limit moved particles after the last collision round: out of the body again,
+    // positions only (collide_round).
+    collide_round(registry, g, s, sub, constraint_rounds(g));
+    update_velocities(g, s, sub);
     // A NaN or infinity must not spread: report it once, count it, and start again from rest.
     if (!all_finite(g.state.x) || !all_finite(g.state.v)) {
         const std::uint64_t bad = count_non_finite(g);
@@ -199,11 +207,7 @@ int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double 
         }
         finish_constraints(g, s, sub);
         if (hooks.after_constraints) hooks.after_constraints(g, s, sub);
-        if (hooks.collide)
-            hooks.collide(g, s, sub);
-        else
-            finish_collision(registry, g, s, sub);
-        if (hooks.after_collision) hooks.after_collision(g, s, sub);
+        finish_collision(registry, g, s, sub);
     }
     return substeps;
 }
@@ -228,7 +232,6 @@ void reset_garment_state(const Registry& registry, Garment& g, GarmentSolver& s)
     std::fill(s.last_collided.begin(), s.last_collided.end(), 0);
     s.lists.valid = false;
     s.anchor_known = false;
-    s.weft_offsets_valid = false;
     collide_garment(g, s);
     ++g.counters.resets;
 }

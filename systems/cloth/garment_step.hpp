@@ -5,17 +5,21 @@
 // Order of a fixed step (method §1 item 4; docs/cloth.md "Solver"):
 //   begin_garment_step        counters restart, pin targets for the end of the step (§3.5)
 //   for each substep:
-//     integrate_garment       cloth_integration: eq. 2 prediction (§3.3-§3.4), then the pins
+//     integrate_garment       cloth_integration: eq. 2 prediction (§3.3-§3.4) of the
+//                             integrated particles, layer 2 carried by layer 1 (simplified,
+//                             §4.2), then the pins
 //     prepare_collision       cloth_collision: colliders at the end of the substep
 //     `rounds` times:
-//       constrain_round       cloth_constraint: (first round, simplified) layer 2 placed from
-//                             layer 1 (§4.2); tethers, springs, Provot's limit (§4.1, §4.2)
+//       constrain_round       cloth_constraint: springs with Provot's limit (§4.1, §4.2),
+//                             then the tethers
 //       collide_round         cloth_collision: candidate lists brought up to date, then
 //                             every particle out of the ellipsoids (§5), positions only
-//     finish_constraints      cloth_constraint: velocities of the integrated particles from
-//                             the substep's move without the push-outs, then contacts (no
-//                             approach, friction)
-//     finish_collision        cloth_collision: the non-finite check
+//     finish_constraints      cloth_constraint: Provot's limit along every warp line from
+//                             the pins down (constraints.hpp limit_warp_lines)
+//     finish_collision        cloth_collision: a last collision round, then the velocities of
+//                             the free particles from the substep's move (less the push-outs
+//                             and the warp limit's moves; at contacts no approach, friction),
+//                             then the non-finite check
 #pragma once
 
 #include <functional>
@@ -49,21 +53,23 @@ void integrate_garment(const Registry& registry, Garment& garment, GarmentSolver
 /// Places the colliders at the end of the substep.
 void prepare_collision(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
-/// One Gauss-Seidel round of tethers, springs and Provot's limit (constraints.hpp); in the
-/// simplified model the first round starts with the weft placement (weft.hpp).
+/// One Gauss-Seidel round of springs with Provot's limit, then tethers (constraints.hpp).
 void constrain_round(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep, int round);
 
 /// One round of collision of every particle, positions only.
 void collide_round(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep,
                    int round);
 
-/// After the rounds: velocities of the integrated particles from their move over the substep,
-/// push-outs left out; where a particle touched an ellipsoid, no velocity toward it relative
-/// to its surface and Coulomb friction.
+/// After the rounds: Provot's limit along every warp line, one-sided from the pins down
+/// (constraints.hpp limit_warp_lines); its moves are kept for the velocities.
 void finish_constraints(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
-/// After the rounds: the non-finite check: a garment with a NaN or infinity is reported on
-/// stderr, counted, and reset.
+/// After finish_constraints: a last collision round (the warp limit moved particles), then
+/// the velocities of the free particles from their move over the substep: the warp limit's
+/// move of the particle below on the line given back (dynamic follow-the-leader), the
+/// push-outs left out; where a particle touched an ellipsoid, no velocity toward it relative
+/// to its surface and Coulomb friction. Then the non-finite check: a garment with a NaN or
+/// infinity is reported on stderr, counted, and reset.
 void finish_collision(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
 /// Constraint rounds per substep of the garment's material.
@@ -72,10 +78,8 @@ void finish_collision(const Registry& registry, Garment& garment, GarmentSolver&
 /// Hooks for stepping by hand: each, when set, is called with the substep.
 struct StepHooks {
     using Hook = std::function<void(Garment&, GarmentSolver&, const ClothSubstep&)>;
-    Hook collide_round;      ///< In place of each collide_round.
+    Hook collide_round;      ///< In place of each collide_round of the rounds.
     Hook after_constraints;  ///< After finish_constraints.
-    Hook collide;            ///< In place of finish_collision.
-    Hook after_collision;    ///< After finish_collision.
 };
 
 /// One fixed step of one garment, exactly as the cloth systems run it (substeps from the

@@ -1,5 +1,6 @@
 // A garment on a body that does not move comes to rest: the constraints, the layer-2
-// placement and the collision response must not keep feeding each other energy.
+// carriage, the warp limit and the collision response must not keep feeding each other
+// energy.
 #include <gtest/gtest.h>
 
 #include "analytic_body.hpp"
@@ -17,20 +18,19 @@ TEST(StrainRest, SkirtOnAStillBodyComesToRest) {
     GarmentSolver& solver = registry.get<GarmentSolver>(e);
     double mean_speed = 0;
     const int frames = 600, measured = 60;
-    test::step_by_hand(
-        body, registry, g, solver, frames,
-        [&](Garment& garment, GarmentSolver&, const ClothSubstep& ctx, int frame) {
-            if (!ctx.last() || frame < frames - measured) return;
-            double sum = 0;
-            int free = 0;
-            for (Eigen::Index p = 0; p < garment.state.x.cols(); ++p)
-                if (garment.state.inv_mass[p] > 0) {
-                    sum += garment.state.v.col(p).norm();
-                    ++free;
-                }
-            mean_speed += sum / free / measured;
-        },
-        test::StageCheck{}, /*hold_pose=*/true);
+    for (int frame = 0; frame < frames; ++frame) {
+        test::step_by_hand(body, registry, g, solver, 1, test::StageCheck{}, test::StageCheck{}, /*hold_pose=*/true);
+        if (frame < frames - measured) continue;
+        // After the whole frame: the velocities the next frame starts from.
+        double sum = 0;
+        int free = 0;
+        for (Eigen::Index p = 0; p < g.state.x.cols(); ++p)
+            if (g.state.inv_mass[p] > 0) {
+                sum += g.state.v.col(p).norm();
+                ++free;
+            }
+        mean_speed += sum / free / measured;
+    }
     EXPECT_EQ(g.counters.resets, 0u);
     // After 9 s the skirt hangs still: mean particle speed under 1 cm/s.
     EXPECT_LT(mean_speed, 0.01);
