@@ -133,16 +133,39 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
         const auto* skin = registry.try_get<SkinnedMesh>(character);
         if (skin && skin->mesh && skin->mesh->vertex_count() > 0) {
             // Weights of the nearest skin vertex, at the current pose (linear blend skinning).
+            // The fitting zone is on the trunk (method §3.5): on a body with landmarks only
+            // skin carried mostly by the pelvis and spine counts, and only those bones' share
+            // of its weights, so that a hand hanging at the hip or a thigh does not take the
+            // waistband with it.
+            const auto* landmarks = registry.try_get<BodyLandmarks>(character);
+            std::vector<bool> trunk;
+            if (landmarks && landmarks->pelvis_bone >= 0) {
+                trunk.assign(skeleton->skinning.size(), false);
+                for (int bone : landmarks->spine)
+                    if (bone >= 0 && static_cast<std::size_t>(bone) < trunk.size()) trunk[static_cast<std::size_t>(bone)] = true;
+                if (static_cast<std::size_t>(landmarks->pelvis_bone) < trunk.size())
+                    trunk[static_cast<std::size_t>(landmarks->pelvis_bone)] = true;
+                if (landmarks->head_bone >= 0 && static_cast<std::size_t>(landmarks->head_bone) < trunk.size())
+                    trunk[static_cast<std::size_t>(landmarks->head_bone)] = false;
+            }
             const MeshAsset& mesh = *skin->mesh;
             Real best_d = std::numeric_limits<Real>::infinity();
             for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
                 const Eigen::Index vi = static_cast<Eigen::Index>(v);
                 const Vec4i b = mesh.bone_indices.col(vi);
-                const Vec4 w = mesh.bone_weights.col(vi);
+                Vec4 w = mesh.bone_weights.col(vi);
                 bool ok = true;
                 for (int i = 0; i < 4; ++i)
                     if (w[i] != 0 && (b[i] < 0 || static_cast<std::size_t>(b[i]) >= skeleton->skinning.size())) ok = false;
                 if (!ok) continue;
+                if (!trunk.empty()) {
+                    Vec4 on_trunk = Vec4::Zero();
+                    for (int i = 0; i < 4; ++i)
+                        if (w[i] != 0 && trunk[static_cast<std::size_t>(b[i])]) on_trunk[i] = w[i];
+                    const Real share = on_trunk.sum();
+                    if (share < Real(0.5) * w.sum()) continue;
+                    w = on_trunk / share;
+                }
                 const Vec3 posed = blend_skinning(skeleton->skinning, b, w) * Vec3(mesh.bind_positions.col(vi));
                 const Real d = (posed - model).squaredNorm();
                 if (d < best_d) { best_d = d; bones = b; weights = w; found = true; }
