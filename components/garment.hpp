@@ -69,11 +69,8 @@ struct Fabric {
     VectorX area_m2;                        ///< Per particle: the rest area it stands for (a quarter of each quad around it).
     std::vector<std::uint32_t> triangles;   ///< Render triangles over the particle grid.
 
-    // Layer-1 springs (method §3.2, §4.1).
+    // Structural springs (method §3.2, §4.1), both models.
     SpringPhase warp1;       ///< Warp springs between layer-1 particles.
-    SpringPhase weft1;       ///< Simplified only: stretch springs between neighbouring layer-1 particles along the weft
-                             ///< (paper §2.3 (2): layer-1 particles are joined by stretch springs only).
-    // Layer 2 and the classic model.
     SpringPhase warp2;       ///< Warp springs on layer-2 lines.
     SpringPhase weft;        ///< Weft (structural) springs between neighbouring lines.
     SpringPhase shear;       ///< Classic only: grid diagonals.

@@ -427,9 +427,6 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
         for (std::uint32_t row = 0; row + 1 < m; ++row) add(is_layer1(line) ? t->warp1 : t->warp2, line, row, line, row + 1);
     for (std::uint32_t line = 0; line < weft_lines; ++line)
         for (std::uint32_t row = 0; row < m; ++row) add(t->weft, line, row, (line + 1) % n, row);
-    for (std::uint32_t line = 0; line < n; line += stride)
-        if (closed || line + stride < n)
-            for (std::uint32_t row = 0; row < m; ++row) add(t->weft1, line, row, (line + stride) % n, row);
     for (std::uint32_t line = 0; line < weft_lines; ++line) {
         for (std::uint32_t row = 0; row + 1 < m; ++row) add(t->shear, line, row, (line + 1) % n, row + 1);
         for (std::uint32_t row = 0; row + 1 < m; ++row) add(t->shear, (line + 1) % n, row, line, row + 1);
@@ -443,7 +440,7 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
     if (!degenerate.empty()) return fail(std::string(p) + ": " + degenerate);
     // Each phase in particle order (strips, see above). A warp spring's `a` stays the end
     // nearer the fitting zone.
-    for (SpringPhase* phase : {&t->warp1, &t->warp2, &t->weft, &t->weft1, &t->shear, &t->bend}) {
+    for (SpringPhase* phase : {&t->warp1, &t->warp2, &t->weft, &t->shear, &t->bend}) {
         std::vector<std::uint32_t> order(phase->size());
         for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
         std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {

@@ -73,8 +73,8 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             }
         s.springs.clear();
         if (simplified) {
-            // Layer 1's springs (with the areas its particles stand for), then layer 2's.
-            s.springs.push_back(spring_set(t.weft1, area, m.stretch_N_m, true));
+            // Weft springs, then the warp: layer 1's (with the areas its particles stand for),
+            // then layer 2's.
             s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true));
             s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
             s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true));
