@@ -75,7 +75,7 @@ void run_step(Registry& registry, ClothStepBatches& batches, double fixed_dt_s, 
             timed(2, [&] { run_cloth_collision_prepare(registry, batch, sub); });
             for (int round = 0; round < rounds; ++round) {
                 timed(1, [&] { run_cloth_constraint_round(batch, sub, round); });
-                timed(2, [&] { run_cloth_collision_round(registry, batch, sub, round); });
+                if (collides_after(round, rounds)) timed(2, [&] { run_cloth_collision_round(registry, batch, sub, round); });
             }
             timed(1, [&] { run_cloth_constraint_finish(batch, sub); });
             timed(2, [&] { run_cloth_collision_finish(registry, batch, sub); });

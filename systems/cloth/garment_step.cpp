@@ -81,19 +81,21 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
 
 int constraint_rounds(const Garment& g) noexcept { return std::max(1, g.config.material.iterations); }
 
+bool collides_after(int round, int rounds) noexcept { return (rounds - 1 - round) % constraint_rounds_per_collision == 0; }
+
 void prepare_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
     update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
 }
 
-void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int) {
+void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int round) {
     prepare_solver(g, s);
     Matrix3X& x = g.state.x;
     const Real h = static_cast<Real>(sub.h_s);
     const Real limit = g.config.material.strain_limit;
     s.x_rows = x;  // one row per coordinate: the strips run in vector lanes
     for (SpringSet& set : s.springs) solve_springs(set, s.x_rows, s.inv_mass, h, limit);
-    solve_tethers(s.tethers, s.x_rows);
+    if (round + 1 == constraint_rounds(g)) solve_tethers(s.tethers, s.x_rows);
     x = s.x_rows;
 }
 
@@ -200,6 +202,7 @@ int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double 
         prepare_collision(registry, g, s, sub);
         for (int round = 0; round < rounds; ++round) {
             constrain_round(g, s, sub, round);
+            if (!collides_after(round, rounds)) continue;
             if (hooks.collide_round)
                 hooks.collide_round(g, s, sub);
             else
