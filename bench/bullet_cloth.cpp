@@ -5,10 +5,17 @@
 //      derives its velocity over the frame (saveKinematicState) for the contacts;
 //   2. each pinned node gets the velocity that carries it to its target over the frame
 //      (pinned nodes have inverse mass 0 but are still advected by predictMotion);
-//   3. stepSimulation(frame, substeps, frame / substeps);
+//   3. stepSimulation(frame, substeps, frame / substeps); in each internal step Bullet
+//      predicts the nodes, collects the contacts, calls the world's internal tick callback
+//      (here: the deepest free node inside an ellipsoid, before the response), then solves
+//      links and contacts;
 //   4. pinned nodes are snapped to their targets (no drift).
+// Rest lengths: Bullet takes a link's rest length from the nodes' distance when it first
+// updates its constants (btSoftBody::updateConstants, on the first predictMotion after
+// appendLink); create() runs that update itself and then writes the given rest lengths.
 #include "bench/bullet_cloth.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -16,6 +23,8 @@
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
+
+#include "bench/report.hpp"
 
 namespace drape::bench {
 
@@ -48,6 +57,25 @@ struct BulletCloth::Impl {
     std::unique_ptr<btSoftBody> cloth;
     std::vector<std::uint32_t> pinned;
     BulletTuning tuning;
+    std::vector<Affine3> ellipsoids;   ///< This frame's poses (what the kinematic bodies hold).
+    BulletFrame frame;
+
+    // After Bullet's prediction and contact collection, before its solve (see step 3).
+    static void after_prediction(btDynamicsWorld* world, btScalar) {
+        auto* self = static_cast<Impl*>(world->getWorldUserInfo());
+        const std::int64_t start = now_ns();
+        self->frame.penetration_before_m =
+            std::max(self->frame.penetration_before_m, max_penetration_m(self->node_positions(), self->ellipsoids, self->pinned));
+        self->frame.probe_ms += elapsed_ms(start);
+    }
+    Matrix3X node_positions() const {
+        Matrix3X x(3, cloth->m_nodes.size());
+        for (int i = 0; i < cloth->m_nodes.size(); ++i) {
+            const btVector3& p = cloth->m_nodes[i].m_x;
+            x.col(i) = Vec3(p.x(), p.y(), p.z());
+        }
+        return x;
+    }
 
     ~Impl() {
         if (cloth) world.removeSoftBody(cloth.get());
@@ -67,6 +95,13 @@ Result<BulletCloth> BulletCloth::create(const ClothSpec& spec, const std::vector
     if (!(spec.mass_kg > 0)) return fail("bullet peer: particle mass must be > 0");
     for (const auto& s : spec.springs)
         if (s[0] >= n || s[1] >= n || s[0] == s[1]) return fail("bullet peer: a spring names a missing particle");
+    if (!spec.rest_m.empty() && spec.rest_m.size() != spec.springs.size())
+        return fail("bullet peer: " + std::to_string(spec.rest_m.size()) + " rest lengths for " +
+                    std::to_string(spec.springs.size()) + " springs");
+    for (Real rest : spec.rest_m)
+        if (!(rest > 0) || !std::isfinite(rest)) return fail("bullet peer: a rest length is not a positive number");
+    if (!spec.masses_kg.empty() && spec.masses_kg.size() != n)
+        return fail("bullet peer: " + std::to_string(spec.masses_kg.size()) + " masses for " + std::to_string(n) + " particles");
     for (auto p : spec.pinned)
         if (p >= n) return fail("bullet peer: a pinned index is out of range");
     if (tuning.substeps < 1 || tuning.position_iterations < 1) return fail("bullet peer: substeps and iterations must be >= 1");
@@ -74,6 +109,9 @@ Result<BulletCloth> BulletCloth::create(const ClothSpec& spec, const std::vector
     auto impl = std::make_unique<Impl>();
     impl->tuning = tuning;
     impl->pinned = spec.pinned;
+    std::sort(impl->pinned.begin(), impl->pinned.end());
+    impl->ellipsoids = ellipsoids;
+    impl->world.setInternalTickCallback(&Impl::after_prediction, impl.get(), false);
     impl->world.setGravity(btVector3(0, -standard_gravity_m_s2, 0));
     impl->info = &impl->world.getWorldInfo();
     impl->info->m_gravity = btVector3(0, -standard_gravity_m_s2, 0);
@@ -103,10 +141,14 @@ Result<BulletCloth> BulletCloth::create(const ClothSpec& spec, const std::vector
         impl->radii.push_back(radii);
     }
 
-    // The cloth: the same particles and structural springs.
+    // The cloth: the same particles, masses and springs.
     std::vector<btVector3> x(n);
     std::vector<btScalar> m(n, spec.mass_kg);
-    for (std::uint32_t i = 0; i < n; ++i) x[i] = to_bt(spec.x.col(i));
+    for (std::uint32_t i = 0; i < n; ++i) {
+        x[i] = to_bt(spec.x.col(i));
+        if (!spec.masses_kg.empty()) m[i] = spec.masses_kg[i];
+        if (!(m[i] > 0) || !std::isfinite(m[i])) return fail("bullet peer: particle " + std::to_string(i) + " has no positive mass");
+    }
     for (auto p : spec.pinned) m[p] = 0;
     impl->cloth = std::make_unique<btSoftBody>(impl->info, static_cast<int>(n), x.data(), m.data());
     btSoftBody& sb = *impl->cloth;
@@ -115,7 +157,16 @@ Result<BulletCloth> BulletCloth::create(const ClothSpec& spec, const std::vector
     material->m_kAST = 1;
     material->m_kVST = 1;
     for (const auto& s : spec.springs) sb.appendLink(static_cast<int>(s[0]), static_cast<int>(s[1]), material);
-    if (tuning.bending_links) sb.generateBendingConstraints(2, material);
+    // Bullet's own constant update (rest lengths from the distances, link and area
+    // constants), done now so that it does not run again, then the given rest lengths.
+    sb.updateConstants();
+    sb.m_bUpdateRtCst = false;
+    if (!spec.rest_m.empty())
+        for (int i = 0; i < sb.m_links.size(); ++i) {
+            btSoftBody::Link& link = sb.m_links[i];
+            link.m_rl = spec.rest_m[static_cast<std::size_t>(i)];
+            link.m_c1 = link.m_rl * link.m_rl;
+        }
     sb.m_cfg.piterations = tuning.position_iterations;
     sb.m_cfg.diterations = tuning.drift_iterations;
     sb.m_cfg.kDP = tuning.damping;
@@ -131,6 +182,8 @@ Result<BulletCloth> BulletCloth::create(const ClothSpec& spec, const std::vector
 
 void BulletCloth::step(const Matrix3X& pinned_x, const std::vector<Affine3>& ellipsoids, double frame_dt_s) {
     Impl& impl = *m_impl;
+    impl.frame = {};
+    impl.ellipsoids = ellipsoids;
     for (std::size_t i = 0; i < impl.bodies.size() && i < ellipsoids.size(); ++i)
         impl.motion_states[i]->setWorldTransform(rigid_pose(ellipsoids[i], impl.radii[i]));
     btSoftBody& sb = *impl.cloth;
@@ -148,14 +201,15 @@ void BulletCloth::step(const Matrix3X& pinned_x, const std::vector<Affine3>& ell
     }
 }
 
-Matrix3X BulletCloth::positions() const {
+Matrix3X BulletCloth::positions() const { return m_impl->node_positions(); }
+
+BulletFrame BulletCloth::last_frame() const { return m_impl->frame; }
+
+std::vector<Real> BulletCloth::link_rest_lengths() const {
     const btSoftBody& sb = *m_impl->cloth;
-    Matrix3X x(3, sb.m_nodes.size());
-    for (int i = 0; i < sb.m_nodes.size(); ++i) {
-        const btVector3& p = sb.m_nodes[i].m_x;
-        x.col(i) = Vec3(p.x(), p.y(), p.z());
-    }
-    return x;
+    std::vector<Real> rest(static_cast<std::size_t>(sb.m_links.size()));
+    for (int i = 0; i < sb.m_links.size(); ++i) rest[static_cast<std::size_t>(i)] = sb.m_links[i].m_rl;
+    return rest;
 }
 
 double max_penetration_m(const Matrix3X& x, const std::vector<Affine3>& ellipsoids,
@@ -190,6 +244,29 @@ double max_strain(const Matrix3X& x, const std::vector<std::array<std::uint32_t,
         if (rest_m[s] > 0) strain = std::max(strain, length / rest_m[s] - 1.0);
     }
     return strain;
+}
+
+BulletSelection select_bullet_configuration(const std::vector<BulletCandidate>& candidates, const BulletSelectionRule& rule) {
+    BulletSelection chosen;
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+        const BulletCandidate& c = candidates[i];
+        if (!c.usable || !(c.strain_p99 <= rule.strain_p99_max) || !(c.penetration_after_m <= rule.penetration_after_max_m)) continue;
+        if (chosen.index < 0 || c.ms_per_frame < candidates[static_cast<std::size_t>(chosen.index)].ms_per_frame)
+            chosen = {static_cast<int>(i), true};
+    }
+    if (chosen.index >= 0) return chosen;
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+        const BulletCandidate& c = candidates[i];
+        if (!c.usable || !std::isfinite(c.strain_p99)) continue;
+        if (chosen.index < 0) {
+            chosen.index = static_cast<int>(i);
+            continue;
+        }
+        const BulletCandidate& best = candidates[static_cast<std::size_t>(chosen.index)];
+        if (c.strain_p99 < best.strain_p99 || (c.strain_p99 == best.strain_p99 && c.ms_per_frame < best.ms_per_frame))
+            chosen.index = static_cast<int>(i);
+    }
+    return chosen;
 }
 
 std::vector<Real> rest_lengths(const Matrix3X& x, const std::vector<std::array<std::uint32_t, 2>>& springs) {
