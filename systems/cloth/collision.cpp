@@ -576,51 +576,35 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         v.col(p) = vp;
     };
 
-    if (candidates) {
-        // List mode: 64 particles at a time against the ellipsoids of their lists (detect_block).
-        LaneBits block_lists{}, block_hits{};
-        for (Eigen::Index begin = first; begin < end; begin += detect_lanes) {
-            const Eigen::Index count = std::min(detect_lanes, end - begin);
-            const std::size_t bi = static_cast<std::size_t>(begin);
-            block_lists.fill(0);
-            std::uint64_t any = 0;
-            for (Eigen::Index l = 0; l < count; ++l) {
-                const std::size_t li = static_cast<std::size_t>(l);
-                block_lists[li] = inv_mass[begin + l] != 0 ? (*candidates)[bi + li] & active : 0;  // pinned: none
-                r.tests += static_cast<std::uint64_t>(std::popcount(block_lists[li]));
-                any |= block_lists[li];
-            }
-            block_hits.fill(0);
-            if (any == 0 || !detect_block(x, begin, count, frames, block_lists, block_hits)) {  // no contact
-                std::fill_n(last_collided.begin() + static_cast<std::ptrdiff_t>(bi), count, 0);
-                if (detected) std::fill_n(detected->begin() + static_cast<std::ptrdiff_t>(bi), count, 0);
-                continue;
-            }
-            for (Eigen::Index l = 0; l < count; ++l) {
-                const std::size_t li = static_cast<std::size_t>(l);
-                if (block_hits[li] != 0) {
-                    collide_one(begin + l, block_hits[li]);
-                } else {
-                    last_collided[bi + li] = 0;
-                    if (detected) (*detected)[bi + li] = 0;
-                }
-            }
+    // 64 particles at a time against the ellipsoids of their lists (detect_block); brute
+    // force lists every active ellipsoid for every free particle, through the same code.
+    LaneBits block_lists{}, block_hits{};
+    for (Eigen::Index begin = first; begin < end; begin += detect_lanes) {
+        const Eigen::Index count = std::min(detect_lanes, end - begin);
+        const std::size_t bi = static_cast<std::size_t>(begin);
+        block_lists.fill(0);
+        std::uint64_t any = 0;
+        for (Eigen::Index l = 0; l < count; ++l) {
+            const std::size_t li = static_cast<std::size_t>(l);
+            const std::uint64_t list = candidates ? (*candidates)[bi + li] & active : active;
+            block_lists[li] = inv_mass[begin + l] != 0 ? list : 0;  // pinned: none
+            r.tests += static_cast<std::uint64_t>(std::popcount(block_lists[li]));
+            any |= block_lists[li];
         }
-    } else {
-        // Brute force: every particle against every ellipsoid.
-        for (Eigen::Index p = first; p < end; ++p) {
-            std::uint64_t hits = 0;
-            if (inv_mass[p] != 0) {
-                const Vec3 xp = x.col(p);
-                for_each_bit(active, [&](int e) {
-                    ++r.tests;
-                    if (to_unit_sphere(frames[static_cast<std::size_t>(e)], xp).squaredNorm() < 1) hits |= std::uint64_t(1) << e;
-                });
+        block_hits.fill(0);
+        if (any == 0 || !detect_block(x, begin, count, frames, block_lists, block_hits)) {  // no contact
+            std::fill_n(last_collided.begin() + static_cast<std::ptrdiff_t>(bi), count, 0);
+            if (detected) std::fill_n(detected->begin() + static_cast<std::ptrdiff_t>(bi), count, 0);
+            continue;
+        }
+        for (Eigen::Index l = 0; l < count; ++l) {
+            const std::size_t li = static_cast<std::size_t>(l);
+            if (block_hits[li] != 0) {
+                collide_one(begin + l, block_hits[li]);
+            } else {
+                last_collided[bi + li] = 0;
+                if (detected) (*detected)[bi + li] = 0;
             }
-            if (hits != 0)
-                collide_one(p, hits);
-            else
-                last_collided[static_cast<std::size_t>(p)] = 0;
         }
     }
     return r;
