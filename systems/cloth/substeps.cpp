@@ -26,17 +26,17 @@ int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver
     const GarmentBody& body = g.body;
     const EllipsoidCollider* anchor = body.anchor >= 0 && static_cast<std::size_t>(body.anchor) < body.colliders.size()
         ? registry.try_get<EllipsoidCollider>(body.colliders[static_cast<std::size_t>(body.anchor)]) : nullptr;
-    std::uint64_t reach = ~std::uint64_t(0);
-    if (g.config.collision == CollisionMode::candidate_lists && solver.lists.valid) {
-        reach = 0;
-        for (std::uint64_t c : solver.lists.bits) reach |= c;
-    }
+    // Colliders the garment can reach: those whose box comes within the candidate margin of
+    // the garment's box (the same in both collision modes).
+    const Vec3 low = g.state.x.rowwise().minCoeff().array() - g.config.material.candidate_margin_m;
+    const Vec3 high = g.state.x.rowwise().maxCoeff().array() + g.config.material.candidate_margin_m;
     const Vec3 anchor_c = anchor ? Vec3(anchor->world.translation()) : Vec3::Zero();
     for (std::size_t e = 0; e < body.colliders.size() && e < 64; ++e) {
-        if (!(reach >> e & 1)) continue;
         const auto* c = registry.try_get<EllipsoidCollider>(body.colliders[e]);
         if (c == nullptr) continue;
         const Vec3 center = c->world.translation();
+        const Vec3 half = c->world.linear().cwiseAbs().rowwise().sum();  // the unit sphere's box, mapped
+        if (((center - half).array() > high.array()).any() || ((center + half).array() < low.array()).any()) continue;
         Vec3 dv = c->velocity_m_s;
         Vec3 dw = c->angular_velocity_rad_s;
         if (anchor) {
