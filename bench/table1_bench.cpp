@@ -103,12 +103,12 @@ void step_timed(const Registry& registry, Timed& t) {
             t.bookkeeping_ns += now_ns() - b;
         }
     };
-    hooks.collide = [&](Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    hooks.finish_collision = [&](Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
         const std::int64_t a = now_ns();
         finish_collision(registry, g, s, sub);
         t.collide_ns += now_ns() - a;
     };
-    hooks.after_collision = [&](Garment&, GarmentSolver&, const ClothSubstep&) { round = 0; };
+    hooks.after_constraints = [&](Garment&, GarmentSolver&, const ClothSubstep&) { round = 0; };
     const std::int64_t bookkeeping_before = t.bookkeeping_ns;
     const std::int64_t start = now_ns();
     t.substeps += step_garment(registry, t.garment, t.solver, frame_dt_s, t.settings, hooks);

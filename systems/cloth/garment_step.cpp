@@ -210,7 +210,10 @@ int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double 
         }
         finish_constraints(g, s, sub);
         if (hooks.after_constraints) hooks.after_constraints(g, s, sub);
-        finish_collision(registry, g, s, sub);
+        if (hooks.finish_collision)
+            hooks.finish_collision(g, s, sub);
+        else
+            finish_collision(registry, g, s, sub);
     }
     return substeps;
 }

@@ -92,6 +92,7 @@ struct StepHooks {
     using Hook = std::function<void(Garment&, GarmentSolver&, const ClothSubstep&)>;
     Hook collide_round;      ///< In place of each collide_round of the rounds.
     Hook after_constraints;  ///< After finish_constraints.
+    Hook finish_collision;   ///< In place of finish_collision.
 };
 
 /// One fixed step of one garment, exactly as the cloth systems run it (substeps from the
