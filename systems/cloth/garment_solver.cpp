@@ -96,6 +96,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
     }
     if (s.force.cols() != n) s.force = Matrix3X::Zero(3, n);
     if (s.warp_moves.cols() != n) s.warp_moves = Matrix3X::Zero(3, n);
+    if (s.x_round.cols() != n) s.x_round = Matrix3X::Zero(3, n);
     if (s.movable.size() != static_cast<std::size_t>(n)) {
         s.movable.resize(static_cast<std::size_t>(n));
         for (Eigen::Index i = 0; i < n; ++i) s.movable[static_cast<std::size_t>(i)] = state.inv_mass[i] != 0;

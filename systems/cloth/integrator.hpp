@@ -19,7 +19,9 @@
 //   -s_lin (V - V_prev) - s_ang (W - W_prev) x (x - c0) at the step's first substep.
 // - Symplectic Euler: u += h du/dt, r += h u; then back to the world with the frame at the
 //   end of the substep: x = R1 r + c1, v = R1 u + V + W x (x - c1). With both scales 1 this
-//   is the world-frame motion; with 0 a particle at rest in the frame stays at rest in it.
+//   is the world-frame motion, and it is integrated in the world directly (the same scheme,
+//   v += h dv/dt, x += h v, without the frame changes); with 0 a particle at rest in the
+//   frame stays at rest in it.
 // Pinned particles (inverse mass 0) are left to the pins.
 #pragma once
 
