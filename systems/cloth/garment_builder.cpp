@@ -331,12 +331,19 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
     g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular};
     g.body.character = character;
-    g.body.colliders = colliders;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
     std::size_t anchor = outline.front();
     for (std::size_t e : outline)
         if ((frames[e].center - origin).norm() < (frames[anchor].center - origin).norm()) anchor = e;
-    g.body.anchor = static_cast<std::int32_t>(anchor);
+    // Hung from under the arms, the garment has the upper arms outside it: they hang against
+    // the chest, their ellipsoids overlap it, and cloth between the two cannot be outside
+    // both. It does not collide with them: it stays on the chest, under the arm.
+    for (std::size_t e = 0; e < colliders.size(); ++e) {
+        if (s.ring_at == RingPlace::under_arms && registry.get<EllipsoidCollider>(colliders[e]).region == BodyRegion::upper_arm)
+            continue;
+        if (e == anchor) g.body.anchor = static_cast<std::int32_t>(g.body.colliders.size());
+        g.body.colliders.push_back(colliders[e]);
+    }
     return finish(registry, std::move(g), s.fitting_rows);
 }
 
