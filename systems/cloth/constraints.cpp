@@ -152,11 +152,11 @@ void solve_tethers(const Tethers& t, Matrix3XRows& x) {
     }
 }
 
-void limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real limit, Matrix3X& x,
+void limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real stretch, Matrix3X& x,
                       Matrix3X& moves) {
     moves.setZero();
     const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
-    const Real scale = 1 + limit;
+    const Real scale = 1 + stretch;
     // Row after row from the fitting zone down, every line of the row in turn: the particle
     // above has its final place when its neighbour below is limited.
     for (std::uint32_t row = 1; row < m; ++row)

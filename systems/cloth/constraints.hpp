@@ -11,8 +11,8 @@
 //      line than the rest length of the line between them (long-range attachments, as Jolt
 //      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
 //      line's weight up to its pin, the tether does it in one).
-// After the rounds, once per substep, limit_warp_lines holds every warp spring within the
-// limit by a one-sided pass from the pins down (follow the leader).
+// After the rounds, once per substep, limit_warp_lines holds every warp spring within half
+// the limit by a one-sided pass from the pins down (follow the leader).
 // Positions only: the velocities follow from the whole substep's move afterwards
 // (garment_step.hpp), as Provot's velocities follow his corrections.
 #pragma once
@@ -75,12 +75,12 @@ struct Tethers {
 /// One pass over the tethers (step 2).
 void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 
-/// After the rounds: Provot's limit along the warp, one-sided (method §4.1: the end nearer
-/// the pins stays, as a pinned end does). Row after row from the fitting zone down, a free
-/// particle farther than (1 + limit) x rest from the particle above it on its line is moved
-/// back onto that sphere, so no warp spring is over the limit afterwards. `moves` receives
-/// each particle's move (zero for the rest).
-void limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real limit,
+/// After the rounds: the warp limit (Provot's rule for a fixed end, method §4.1). Row after
+/// row from the fitting zone down, a free particle farther than (1 + stretch) x rest from
+/// the particle above it on its line is moved back onto that sphere, the particle above
+/// staying where it is (it already has its final place), so no warp spring is longer than
+/// that afterwards. `moves` receives each particle's move (zero for the rest).
+void limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real stretch,
                       Matrix3X& x, Matrix3X& moves);
 
 /// Largest length / rest - 1 over `springs` (0 when none is stretched).
