@@ -21,13 +21,6 @@ std::shared_ptr<const CharacterAsset> load(const fs::path& file) {
     return c ? *c : nullptr;
 }
 
-// Present, or (one of several files) skipped with a failure under CI.
-bool present_or_skip(const fs::path& file) {
-    if (fs::exists(file)) return true;
-    if (test::under_ci()) ADD_FAILURE() << file << " is absent under CI";
-    return false;
-}
-
 // What holds on any humanoid: the order of the heights, limbs on their sides, sections
 // that are real outlines of a trunk.
 void expect_humanoid(const BodyLandmarks& l, const std::string& file) {
@@ -72,7 +65,7 @@ TEST(BodyLandmarks, SharedHumanoidsByTopology) {
     for (const char* relative : {"characters/male_casual/Male_Casual.fbx", "characters/female_alternative/Female_Alternative.fbx",
                                  "characters/robot_expressive/RobotExpressive.glb"}) {
         const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / relative;
-        if (!present_or_skip(file)) continue;
+        DRAPE_REQUIRE_SHARED(file);
         const auto c = load(file);
         ASSERT_TRUE(c);
         const auto l = find_body_landmarks(*c);

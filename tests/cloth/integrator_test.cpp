@@ -86,20 +86,21 @@ struct MovingFrame {
     }
 };
 
-// Runs `steps` substeps of predict_particles on one free particle (no gravity, no drag)
-// carried by the moving frame with inertia scales `inertia`; returns its world position and
-// velocity, and the frame's last pose.
+// Runs `steps` substeps of predict_particles on one free particle of 10 g (by default no
+// gravity, no drag) carried by the moving frame with inertia scales `inertia`; returns its
+// world position and velocity, and the frame's last pose.
 struct Carried {
     Vec3 x, v;
     Mat3 r;
     Vec3 c;
 };
-Carried carry(const InertiaScales& inertia, int steps, double h, const Vec3& x0, const Vec3& v0) {
+Carried carry(const InertiaScales& inertia, int steps, double h, const Vec3& x0, const Vec3& v0,
+              const Vec3& gravity = Vec3::Zero(), Real drag_N_s_m = 0) {
     const MovingFrame frame;
     Matrix3X x(3, 1), v(3, 1);
     x.col(0) = x0;
     v.col(0) = v0;
-    const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+    const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Constant(1, drag_N_s_m);
     Mat3 r = Mat3::Identity();
     Vec3 c = Vec3::Zero();
     Vec3 v_before = frame.velocity(0), w_before = frame.angular(0);
@@ -116,7 +117,7 @@ Carried carry(const InertiaScales& inertia, int steps, double h, const Vec3& x0,
         m.velocity_before_m_s = v_before;
         m.angular_velocity_before_rad_s = w_before;
         m.acceleration_m_s2 = (m.velocity_m_s - v_before) / Real(h);
-        predict_particles(x, v, inv_mass, drag, 1, m, inertia, Vec3::Zero(), Real(h));
+        predict_particles(x, v, inv_mass, drag, 1, m, inertia, gravity, Real(h));
         v_before = m.velocity_m_s;
         w_before = m.angular_velocity_rad_s;
     }
@@ -138,6 +139,41 @@ TEST(AnchorFrame, WithFullInertiaAFreeParticleMovesInAStraightLineWhateverTheBod
         // Integrated in the world (the frame's motion cancels): exact up to float rounding.
         EXPECT_LT(error, 1e-5) << "h = " << h;
         EXPECT_LT((p.v - v0).norm(), 1e-5) << "h = " << h;
+    }
+}
+
+// Inertia scales 1 under gravity and air drag: eq. 2 written in the accelerating, turning
+// frame must give the world's motion, m dv/dt = m g - k v (still air), whose answer is
+//   v(t) = v_inf + (v0 - v_inf) e^(-t k/m),  x(t) = x0 + v_inf t + (v0 - v_inf) (1 - e^(-t k/m)) m/k,
+// with v_inf = m g / k. The frame's own velocity (up to 2 m/s) and turn (up to 2.5 rad/s)
+// must vanish from the answer: drag on the velocity relative to the frame instead of the
+// world, gravity not turned into the frame, or a wrong sign or factor in the inertial terms
+// leave an error that does not shrink with the step.
+TEST(AnchorFrame, WithFullInertiaGravityAndDragActAsInTheWorld) {
+    const Vec3 x0(Real(0.3), Real(-0.4), Real(0.2)), v0(Real(0.6), Real(0.5), Real(-0.3));
+    const Vec3 g(0, -standard_gravity_m_s2, 0);
+    const double mass = 0.01, k = 0.02, rate = k / mass;  // drag time m/k = 0.5 s
+    const double t = 0.5;
+    const Eigen::Vector3d v_inf = g.cast<double>() / rate;
+    const double decay = std::exp(-rate * t);
+    const Eigen::Vector3d v_exact = v_inf + (v0.cast<double>() - v_inf) * decay;
+    const Eigen::Vector3d x_exact = x0.cast<double>() + v_inf * t + (v0.cast<double>() - v_inf) * (1 - decay) / rate;
+    double previous_x = 0, previous_v = 0;
+    for (int refine : {1, 2, 4}) {
+        const double h = 1.0 / (120.0 * refine);
+        const int steps = 60 * refine;
+        const Carried p = carry(InertiaScales{}, steps, h, x0, v0, g, Real(k));
+        const double error_x = (p.x.cast<double>() - x_exact).norm();
+        const double error_v = (p.v.cast<double>() - v_exact).norm();
+        // Symplectic Euler's own error is about |g| h t / 2 = 2 cm at h = 1/120 s.
+        EXPECT_LT(error_x, 0.05) << "h = " << h;
+        EXPECT_LT(error_v, 0.2) << "h = " << h;
+        if (refine > 1) {
+            EXPECT_LT(error_x, 0.7 * previous_x) << "first order: the position error shrinks with the step";
+            EXPECT_LT(error_v, 0.7 * previous_v) << "first order: the velocity error shrinks with the step";
+        }
+        previous_x = error_x;
+        previous_v = error_v;
     }
 }
 
@@ -168,6 +204,47 @@ TEST(AnchorFrame, LinearInertiaScaleSetsHowMuchOfTheBodysJerkTheParticleFeels) {
         EXPECT_NEAR(v(0, 0), (1 - s) * 2, 1e-5) << "s = " << s;
         EXPECT_NEAR(x(0, 0), (1 - s) * 2 * h, 1e-6) << "s = " << s;
     }
+}
+
+// A frame accelerating steadily (a, no turn) with linear inertia scale s, under gravity, no
+// drag: relative to the frame the particle feels g - s a, so over t it moves
+//   r(t) - r(0) = u0 t + (g - s a) t^2 / 2,   u0 = v0 - V(0),
+// and in the world x(t) = x0 + v0 t + (g + (1 - s) a) t^2 / 2. Symplectic Euler's error is
+// first order: (g + s a) h t / 2 for this scheme; allowed is twice that (5 mm at the finer
+// step). A scale applied as 1 - s, twice per step, or not at all misses by 2.6 cm or more.
+TEST(AnchorFrame, LinearInertiaScaleInAnAcceleratingFrameGivesTheAnalyticDisplacement) {
+    const Vec3 a(3, Real(0.5), Real(-1.5)), v_frame0(Real(0.5), 0, Real(0.2));
+    const Vec3 g(0, -standard_gravity_m_s2, 0);
+    const Vec3 x0(Real(0.1), Real(-0.3), Real(0.05)), v0(Real(0.4), Real(0.3), Real(-0.2));
+    for (Real s : {Real(0), Real(0.25), Real(1)})
+        for (int refine : {1, 4}) {
+            const double h = 1.0 / (120.0 * refine), t = 0.25;
+            const int steps = static_cast<int>(std::lround(t / h));
+            Matrix3X x(3, 1), v(3, 1);
+            x.col(0) = x0;
+            v.col(0) = v0;
+            const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+            Vec3 c = Vec3::Zero(), v_before = v_frame0;
+            for (int n = 0; n < steps; ++n) {
+                AnchorMotion m;
+                m.c0 = c;
+                m.velocity_m_s = v_frame0 + a * Real(n * h);
+                m.velocity_before_m_s = v_before;
+                m.acceleration_m_s2 = a;
+                c += m.velocity_m_s * Real(h);
+                m.c1 = c;
+                predict_particles(x, v, inv_mass, drag, 1, m, InertiaScales{s, 1}, g, Real(h));
+                v_before = m.velocity_m_s;
+            }
+            const Eigen::Vector3d gd = g.cast<double>(), ad = a.cast<double>();
+            const Eigen::Vector3d in_frame = (x.col(0) - c).cast<double>() - x0.cast<double>();
+            const Eigen::Vector3d expected = (v0 - v_frame0).cast<double>() * t + (gd - double(s) * ad) * t * t / 2;
+            const double bound = (gd + double(s) * ad).norm() * h * t;
+            EXPECT_LT((in_frame - expected).norm(), bound) << "s = " << s << ", h = " << h;
+            const Eigen::Vector3d world = x.col(0).cast<double>() - x0.cast<double>();
+            const Eigen::Vector3d world_expected = v0.cast<double>() * t + (gd + (1 - double(s)) * ad) * t * t / 2;
+            EXPECT_LT((world - world_expected).norm(), bound + ad.norm() * h * t) << "s = " << s << ", h = " << h;
+        }
 }
 
 // A mass hanging from a pinned end on one spring in compliance form settles where the

@@ -87,7 +87,7 @@ std::vector<unsigned char> run(const SceneDescription& scene, int frames) {
 }
 
 TEST(Crowd, HeadlessWorldSkinsNoMeshVertex) {
-    if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
+    ASSERT_TRUE(avatar_present()) << "the default avatar (assets/avatar.glb) is part of the project";
     auto world = build_world(walkers(3, 0.3, 0), {});
     ASSERT_TRUE(world) << world.error().message;
     std::vector<std::uint64_t> at_start;
@@ -112,7 +112,7 @@ TEST(Crowd, HeadlessWorldSkinsNoMeshVertex) {
 }
 
 TEST(Crowd, OneOrTwoThreadsGiveIdenticalBytes) {
-    if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
+    ASSERT_TRUE(avatar_present()) << "the default avatar (assets/avatar.glb) is part of the project";
     const auto one = run(walkers(6, 0.17, 1), 45);
     const auto two = run(walkers(6, 0.17, 2), 45);
     ASSERT_FALSE(one.empty());
@@ -121,7 +121,7 @@ TEST(Crowd, OneOrTwoThreadsGiveIdenticalBytes) {
 }
 
 TEST(Crowd, AGarmentStepsTheSameWhoeverElseIsInTheScene) {
-    if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
+    ASSERT_TRUE(avatar_present()) << "the default avatar (assets/avatar.glb) is part of the project";
     // Neighbours on other phases need other substep counts at other times; the first
     // walker's skirt takes its own.
     auto alone = build_world(walkers(1, 0.0, 0), {});
@@ -142,7 +142,7 @@ TEST(Crowd, AGarmentStepsTheSameWhoeverElseIsInTheScene) {
 }
 
 TEST(Crowd, StartTimePutsWalkersOnDifferentPhases) {
-    if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
+    ASSERT_TRUE(avatar_present()) << "the default avatar (assets/avatar.glb) is part of the project";
     auto world = build_world(walkers(2, 0.4, 0), {});
     ASSERT_TRUE(world) << world.error().message;
     const auto& a = world->registry.get<AnimationPlayer>(world->characters[0]);
@@ -160,7 +160,7 @@ TEST(Crowd, StartTimePutsWalkersOnDifferentPhases) {
 
 TEST(Crowd, StartTimeIsReadAndWrittenBySceneFiles) {
     SceneDescription scene = walkers(2, 0.25, 0);
-    if (!avatar_present()) GTEST_SKIP() << "the default avatar (assets/avatar.glb) is missing";
+    ASSERT_TRUE(avatar_present()) << "the default avatar (assets/avatar.glb) is part of the project";
     auto parsed = parse_scene(to_json(scene), "", {});
     ASSERT_TRUE(parsed) << parsed.error().message;
     EXPECT_DOUBLE_EQ(parsed->characters.at(1).start_s, 0.25);
