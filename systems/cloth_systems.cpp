@@ -6,6 +6,10 @@
 #include <memory>
 #include <optional>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
 #include "components/skeleton.hpp"
@@ -24,69 +28,91 @@ struct ClothSlots {
     bool timed = false;
 };
 
-// The garments of one fixed step, split into groups that step together: the same substep
-// count and constraint rounds. Kept between runs so that a stable scene allocates nothing.
-struct ClothStepBatches {
-    GarmentBatch all;
-    struct Group {
-        int substeps = 1;
-        int rounds = 1;
-        GarmentBatch batch;
-    };
-    std::vector<Group> groups;
-    std::size_t used = 0;
-
-    GarmentBatch& group(int substeps, int rounds) {
-        for (std::size_t k = 0; k < used; ++k)
-            if (groups[k].substeps == substeps && groups[k].rounds == rounds) return groups[k].batch;
-        if (used == groups.size()) groups.emplace_back();
-        Group& g = groups[used++];
-        g.substeps = substeps;
-        g.rounds = rounds;
-        g.batch.items.clear();
-        return g.batch;
-    }
+// How a garment's stages are timed: each system call in its own profiler scope (one
+// garment stepping alone: the frame budget shows every run), or added up per thread (many
+// garments stepping in parallel: shared out afterwards, see run_step).
+struct StageTimes {
+    std::array<std::int64_t, 3> ns{};
 };
 
-// One fixed step of every garment: each takes its own substep count (and rounds), so a
-// garment's result does not depend on the others; garments with the same counts step
-// together, the three systems in every substep, each in its own profiler scope.
-void run_step(Registry& registry, ClothStepBatches& batches, double fixed_dt_s, const ClothSolverSettings& settings,
-              FrameProfiler* profiler, const ClothSlots& slots) {
-    batches.all.gather(registry);
-    if (batches.all.items.empty()) return;
-    batches.used = 0;
-    for (const GarmentWork& w : batches.all.items) {
-        const int substeps = garment_substeps(registry, *w.garment, *w.solver, fixed_dt_s, settings);
-        batches.group(substeps, constraint_rounds(*w.garment)).items.push_back(w);
-    }
+// One fixed step of one garment (a batch of one): the three cloth systems in every substep,
+// in the order of systems/cloth/garment_step.hpp.
+void step_one(const Registry& registry, const GarmentBatch& one, int substeps, int rounds, double fixed_dt_s,
+              FrameProfiler* profiler, const ClothSlots& slots, StageTimes* times) {
     const auto timed = [&](int k, auto&& run) {
+        if (times != nullptr) {
+            const auto start = FrameProfiler::Clock::now();
+            run();
+            times->ns[static_cast<std::size_t>(k)] += (FrameProfiler::Clock::now() - start).count();
+            return;
+        }
         std::optional<ProfileScope> scope;
         if (profiler != nullptr && slots.timed) scope.emplace(*profiler, slots.slot[static_cast<std::size_t>(k)]);
         run();
     };
-    for (std::size_t k = 0; k < batches.used; ++k) {
-        GarmentBatch& batch = batches.groups[k].batch;
-        const int substeps = batches.groups[k].substeps;
-        const int rounds = batches.groups[k].rounds;
-        for (int i = 0; i < substeps; ++i) {
-            const ClothSubstep sub = make_substep(i, substeps, fixed_dt_s);
-            timed(0, [&] { run_cloth_integration(registry, batch, sub); });
-            timed(2, [&] { run_cloth_collision_prepare(registry, batch, sub); });
-            for (int round = 0; round < rounds; ++round) {
-                timed(1, [&] { run_cloth_constraint_round(batch, sub, round); });
-                if (collides_after(round, rounds)) timed(2, [&] { run_cloth_collision_round(registry, batch, sub, round); });
-            }
-            timed(1, [&] { run_cloth_constraint_finish(batch, sub); });
-            timed(2, [&] { run_cloth_collision_finish(registry, batch, sub); });
+    for (int i = 0; i < substeps; ++i) {
+        const ClothSubstep sub = make_substep(i, substeps, fixed_dt_s);
+        timed(0, [&] { run_cloth_integration(registry, one, sub); });
+        timed(2, [&] { run_cloth_collision_prepare(registry, one, sub); });
+        for (int round = 0; round < rounds; ++round) {
+            timed(1, [&] { run_cloth_constraint_round(one, sub, round); });
+            if (collides_after(round, rounds)) timed(2, [&] { run_cloth_collision_round(registry, one, sub, round); });
         }
+        timed(1, [&] { run_cloth_constraint_finish(one, sub); });
+        timed(2, [&] { run_cloth_collision_finish(registry, one, sub); });
+    }
+}
+
+// One fixed step of every garment. Each garment takes its own substep count and rounds, so
+// its result does not depend on the others, and steps through all of them before the next
+// garment is touched: a crowd's garments do not evict each other from the cache between
+// stages. Several garments step in parallel (TBB, one task per garment; each writes only
+// itself, so any number of threads gives the same bytes). Their stages are then timed per
+// thread, and the step's wall time is shared out to the three profiler slots by those
+// times (one run each per fixed step); a garment stepping alone has every system call timed.
+void run_step(Registry& registry, GarmentBatch& all, double fixed_dt_s, const ClothSolverSettings& settings,
+              FrameProfiler* profiler, const ClothSlots& slots) {
+    all.gather(registry);
+    if (all.items.empty()) return;
+    const auto step_item = [&](const GarmentWork& w, StageTimes* times) {
+        const GarmentBatch one{{w}, {}};
+        const int substeps = garment_substeps(registry, *w.garment, *w.solver, fixed_dt_s, settings);
+        step_one(registry, one, substeps, constraint_rounds(*w.garment), fixed_dt_s, profiler, slots, times);
+    };
+    if (all.items.size() == 1) {
+        step_item(all.items.front(), nullptr);
+        return;
+    }
+    const bool timed = profiler != nullptr && slots.timed && profiler->timing();
+    tbb::enumerable_thread_specific<StageTimes> per_thread;
+    const auto start = FrameProfiler::Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, all.items.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) step_item(all.items[i], timed ? &per_thread.local() : nullptr);
+    });
+    const auto end = FrameProfiler::Clock::now();
+    if (profiler == nullptr || !slots.timed) return;
+    if (!timed) {
+        for (std::uint32_t slot : slots.slot) profiler->record_untimed_run(slot);
+        return;
+    }
+    StageTimes sum;
+    for (const StageTimes& t : per_thread)
+        for (std::size_t k = 0; k < sum.ns.size(); ++k) sum.ns[k] += t.ns[k];
+    const double total = static_cast<double>(sum.ns[0] + sum.ns[1] + sum.ns[2]);
+    const double wall = static_cast<double>((end - start).count());
+    auto at = start;
+    for (std::size_t k = 0; k < sum.ns.size(); ++k) {
+        const auto share = FrameProfiler::Clock::duration(
+            static_cast<FrameProfiler::Clock::rep>(total > 0 ? wall * static_cast<double>(sum.ns[k]) / total : 0));
+        profiler->record_run(slots.slot[k], at, at + share);
+        at += share;
     }
 }
 
 }  // namespace
 
 std::uint32_t add_cloth_systems(Scheduler& scheduler, const ClothSolverSettings& settings) {
-    auto batch = std::make_shared<ClothStepBatches>();
+    auto batch = std::make_shared<GarmentBatch>();
     auto slots = std::make_shared<ClothSlots>();  // filled once the step has its own slot
     System step{"cloth", Phase::simulation, {}, components<Garment>(), components<EllipsoidCollider, Skeleton, Transform>(),
                 [batch, settings, slots](Registry& registry, const FrameContext& context) {
@@ -102,8 +128,8 @@ std::uint32_t add_cloth_systems(Scheduler& scheduler, const ClothSolverSettings&
 }
 
 void step_cloth(Registry& registry, double fixed_dt_s, const ClothSolverSettings& settings) {
-    ClothStepBatches batches;
-    run_step(registry, batches, fixed_dt_s, settings, nullptr, ClothSlots{});
+    GarmentBatch all;
+    run_step(registry, all, fixed_dt_s, settings, nullptr, ClothSlots{});
 }
 
 }  // namespace drape

@@ -1,17 +1,19 @@
 // The cloth step: the cloth module's one entry in the scheduler (phase simulation).
 //
-// Each fixed step it gathers the garments (creating a solver for a garment that has none),
-// takes each garment's substeps by the rule in systems/cloth/substeps.hpp (or
-// ClothSolverSettings::fixed_substeps), and runs the garments that need the same substeps
-// and rounds together (in parallel over garments), in every substep the three cloth
+// Each fixed step it gathers the garments (creating a solver for a garment that has none)
+// and steps each garment through all its substeps before the next (in parallel over
+// garments), with its own substep count by the rule in systems/cloth/substeps.hpp (or
+// ClothSolverSettings::fixed_substeps) and its own rounds; in every substep the three cloth
 // systems in the order of systems/cloth/garment_step.hpp:
 //   cloth_integration  (cloth_integration_system.hpp)  method §3.3-§3.5
 //   then rounds of
 //   cloth_constraint   (cloth_constraint_system.hpp)   method §4
-//   cloth_collision    (cloth_collision_system.hpp)    method §5
+//   cloth_collision    (cloth_collision_system.hpp)    method §5 (every second round)
 //   and each of the last two once more to finish the substep.
 // The scheduler times the whole step as "cloth"; each system is timed in a profiler slot of
-// its own under it, so the frame budget lists all four.
+// its own under it, so the frame budget lists all four. A garment stepping alone has every
+// system call timed; with several in parallel, each system's slot gets the step's wall time
+// shared out by the systems' time summed over the threads (one run per fixed step).
 #pragma once
 
 #include "engine/core/scheduler.hpp"
