@@ -200,10 +200,13 @@ Result<void> measure_shape(Row& row, const ConvergedReference& reference, int th
 // --- Contact sheet ---------------------------------------------------------------------
 
 #ifdef DRAPE_HAVE_RENDER
-/// Averages `scale` x `scale` blocks of `source` into the tile at (x0, y0) of `sheet`.
+/// Averages `scale` x `scale` blocks of `source` into the tile at (x0, y0) of `sheet` (what
+/// would fall outside the sheet is left out).
 void put_tile(Image& sheet, const Image& source, int x0, int y0, int scale) {
-    for (int y = 0; y < source.height / scale; ++y)
-        for (int x = 0; x < source.width / scale; ++x)
+    const int height = std::min(source.height / scale, sheet.height - y0);
+    const int width = std::min(source.width / scale, sheet.width - x0);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
             for (int channel = 0; channel < 4; ++channel) {
                 int sum = 0;
                 for (int dy = 0; dy < scale; ++dy)
