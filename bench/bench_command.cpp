@@ -25,6 +25,7 @@ const std::vector<Benchmark>& benchmarks() {
         {"peers", "Bullet soft-body cloth against Drape on the same skirt and ellipsoids", run_peers},
         {"render", "off-screen rendering at 1280x720, ms per frame", run_render},
         {"soak", "the sample scene walking for an hour of simulated time: drift per minute", run_soak},
+        {"quality", "after-frame strain, penetration, cost and shape against a converged reference, per garment x model x character", run_quality},
     };
     return list;
 }

@@ -12,8 +12,10 @@
 #include "bench/probe.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
+#ifdef DRAPE_HAVE_RENDER
 #include "engine/render/renderer.hpp"
 #include "systems/render_system.hpp"
+#endif
 
 namespace drape::bench {
 
@@ -35,8 +37,11 @@ struct Row {
 }  // namespace
 
 Result<void> run_render(const BenchOptions& options) {
+#ifndef DRAPE_HAVE_RENDER
+    (void)options;
+    return fail("render: this build has no render module (DRAPE_RENDER=OFF)");
+#else
     const Machine machine = describe_machine();
-    if (!render_available()) return fail("render: this build has no render module (DRAPE_RENDER=OFF)");
     std::vector<Row> rows;
     std::string renderer_text;
     for (GarmentType garment : {GarmentType::skirt, GarmentType::dress}) {
@@ -129,6 +134,7 @@ Result<void> run_render(const BenchOptions& options) {
     report.plot("render.png", "Rendering ms per frame", data, script);
 
     return finish(report, options, json);
+#endif
 }
 
 }  // namespace drape::bench

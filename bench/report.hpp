@@ -131,5 +131,6 @@ struct Benchmark {
 [[nodiscard]] Result<void> run_peers(const BenchOptions& options);
 [[nodiscard]] Result<void> run_render(const BenchOptions& options);
 [[nodiscard]] Result<void> run_soak(const BenchOptions& options);
+[[nodiscard]] Result<void> run_quality(const BenchOptions& options);
 
 }  // namespace drape::bench
