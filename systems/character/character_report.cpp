@@ -27,7 +27,7 @@ CoverageReport rest_pose_coverage(const CharacterAsset& c, const CharacterBody& 
     skinning_matrices(*c.skeleton, global, skinning);
     Matrix3X positions, normals;
     skin_mesh(*c.mesh, skinning, Affine3::Identity(), positions, normals);
-    return measure_coverage(body.ellipsoids, global, positions, normals, tolerance_m);
+    return measure_coverage(body.ellipsoids, global, positions, normals, c.mesh->indices, tolerance_m);
 }
 
 std::string character_report_text(const CharacterAsset& c, const CharacterBody& body, const CoverageReport& r) {

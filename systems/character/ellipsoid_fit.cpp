@@ -2,7 +2,9 @@
 #include "systems/character/ellipsoid_fit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <map>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -12,7 +14,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "systems/character/ellipsoid_solver.hpp"
 #include "systems/character/pose.hpp"
+#include "systems/character/skin_surface.hpp"
 
 namespace drape {
 
@@ -54,6 +58,9 @@ std::optional<BodyRegion> region_from_string(std::string_view s) {
     return std::nullopt;
 }
 
+// Surface points per ellipsoid for the bulge measure.
+constexpr int bulge_samples_per_ellipsoid = 512;
+
 // Points on the unit sphere, evenly spread (Fibonacci lattice).
 Matrix3X sphere_samples(int n) {
     Matrix3X out(3, n);
@@ -67,11 +74,11 @@ Matrix3X sphere_samples(int n) {
     return out;
 }
 
-// One ellipsoid around a cluster, in the bone frame `frame` (rigid, model space at bind):
-// principal axes, centred on the bounding box in that frame, scaled uniformly until
-// `cluster_coverage` of the points are inside.
-EllipsoidShape fit_cluster(const MeshAsset& mesh, const Affine3& frame, const std::vector<Eigen::Index>& c,
-                           const FitOptions& options) {
+// The ellipsoid that bounds a cluster, in the bone frame `frame` (rigid, model space at
+// bind): principal axes, centred on the box they span, scaled uniformly until 97 % of the
+// points are inside. The legs keep it (FitOptions::hug_legs).
+EllipsoidShape bounding_ellipsoid(const MeshAsset& mesh, const Affine3& frame, const std::vector<Eigen::Index>& c, double min_radius_m) {
+    constexpr double cluster_coverage = 0.97;
     const Affine3 to_bone = frame.inverse();
     Matrix3X q(3, static_cast<Eigen::Index>(c.size()));
     for (std::size_t i = 0; i < c.size(); ++i) q.col(static_cast<Eigen::Index>(i)) = to_bone * mesh.bind_positions.col(c[i]);
@@ -89,20 +96,39 @@ EllipsoidShape fit_cluster(const MeshAsset& mesh, const Affine3& frame, const st
     const Matrix3X y = axes.transpose().lazyProduct(q);  // cluster in the principal frame
     const Vec3 lo = y.rowwise().minCoeff(), hi = y.rowwise().maxCoeff();
     const Vec3 centre_y = (lo + hi) / 2;
-    const Vec3 half = ((hi - lo) / 2).cwiseMax(static_cast<Real>(options.min_radius_m));
+    const Vec3 half = ((hi - lo) / 2).cwiseMax(static_cast<Real>(min_radius_m));
     std::vector<Real> d(c.size());
     for (std::size_t i = 0; i < c.size(); ++i) d[i] = ((y.col(static_cast<Eigen::Index>(i)) - centre_y).cwiseQuotient(half)).norm();
-    const auto k = std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(options.cluster_coverage * double(d.size()))) - 1);
+    const auto k = std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(cluster_coverage * double(d.size()))) - 1);
     std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
     const Real s = std::max(d[k], Real(1e-3));
     EllipsoidShape shape;
     shape.center = axes * centre_y;
     shape.rotation = Quat(axes).normalized();
-    shape.radii_m = (half * s).cwiseMax(static_cast<Real>(options.min_radius_m));
+    shape.radii_m = (half * s).cwiseMax(static_cast<Real>(min_radius_m));
     return shape;
 }
 
-double volume(const EllipsoidShape& s) { return 4.0 / 3.0 * std::numbers::pi * double(s.radii_m.prod()); }
+// Volume of the ellipsoid inscribed in a cluster's box along its principal axes, in the
+// bind pose: what merging two clusters adds when the budget forces it.
+double cluster_volume(const MeshAsset& mesh, const std::vector<Eigen::Index>& c) {
+    if (c.size() < 4) return 0;
+    std::vector<Eigen::Vector3d> points;
+    for (Eigen::Index j : c) points.push_back(mesh.bind_positions.col(j).cast<double>());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& p : points) mean += p;
+    mean /= double(points.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto& p : points) covariance += (p - mean) * (p - mean).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(covariance);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    for (const auto& p : points) {
+        const Eigen::Vector3d y = eig.eigenvectors().transpose() * (p - mean);
+        lo = lo.cwiseMin(y);
+        hi = hi.cwiseMax(y);
+    }
+    return std::numbers::pi / 6 * (hi - lo).prod();
+}
 
 // "LeftArm" <-> "RightArm", "UpperArm.L" <-> "UpperArm.R", "thigh_l" <-> "thigh_r",
 // "FootL" <-> "FootR"; empty when the name has no side.
@@ -135,12 +161,106 @@ std::vector<double> joint_motion(const SkeletonAsset& skeleton, std::span<const 
     return out;
 }
 
+
+// Connected pieces of a mesh: vertices joined by faces or by sharing a position (files
+// split vertices along seams), as one label per vertex.
+std::vector<int> mesh_islands(const MeshAsset& mesh, Real height_m) {
+    const auto n = static_cast<int>(mesh.vertex_count());
+    std::vector<int> parent(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) parent[static_cast<std::size_t>(i)] = i;
+    auto root = [&](int x) {
+        while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        return x;
+    };
+    auto join = [&](int a, int b) {
+        a = root(a);
+        b = root(b);
+        if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+    };
+    const double weld = 1e-5 * std::max(Real(1e-3), height_m);
+    std::map<std::array<long long, 3>, int> at;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 p = mesh.bind_positions.col(i);
+        const std::array<long long, 3> key{std::llround(p.x() / weld), std::llround(p.y() / weld), std::llround(p.z() / weld)};
+        const auto [it, fresh] = at.emplace(key, i);
+        if (!fresh) join(i, it->second);
+    }
+    for (std::size_t f = 0; f + 2 < mesh.indices.size(); f += 3) {
+        const auto a = static_cast<int>(mesh.indices[f]), b = static_cast<int>(mesh.indices[f + 1]), c = static_cast<int>(mesh.indices[f + 2]);
+        if (a >= n || b >= n || c >= n) continue;
+        join(a, b);
+        join(b, c);
+    }
+    std::vector<int> out(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = root(i);
+    return out;
+}
+
+// A rigid mesh is an object bound to a bone (a robot's plate, a ball joint): when one
+// bone carries several such objects of some size, each is a part of its own, so that
+// each gets its own ellipsoid to start from. Small objects (rivets) join the nearest
+// large one. Skinned vertices stay in their bone's part. Parts beyond `budget` are not
+// made (0: no limit).
+void split_rigid_objects(const MeshAsset& mesh, std::span<const MeshInfo> meshes, Real height_m, int budget,
+                         std::vector<int>& part_of_vertex, std::vector<int>& bone_of_part) {
+    std::vector<char> rigid(mesh.vertex_count(), 0);
+    bool any = false;
+    for (const MeshInfo& m : meshes)
+        if (m.rigid)
+            for (std::uint32_t v = m.first_vertex; v < m.first_vertex + m.vertex_count && v < rigid.size(); ++v) rigid[v] = any = 1;
+    if (!any) return;
+    const std::vector<int> island = mesh_islands(mesh, height_m);
+    struct Object {
+        int island, part;
+        std::vector<std::size_t> vertices;
+        Eigen::AlignedBox3f box;
+    };
+    std::map<std::pair<int, int>, Object> objects;  // (part, island)
+    for (std::size_t v = 0; v < rigid.size(); ++v) {
+        if (!rigid[v] || part_of_vertex[v] < 0) continue;
+        Object& o = objects[{part_of_vertex[v], island[v]}];
+        o.island = island[v];
+        o.part = part_of_vertex[v];
+        o.vertices.push_back(v);
+        o.box.extend(mesh.bind_positions.col(static_cast<Eigen::Index>(v)));
+    }
+    const double large = 0.05 * double(height_m);
+    std::map<int, std::vector<const Object*>> large_of_part;
+    for (const auto& [key, o] : objects)
+        if (o.vertices.size() >= 16 && double(o.box.sizes().maxCoeff()) >= large) large_of_part[o.part].push_back(&o);
+    int parts = static_cast<int>(bone_of_part.size());
+    for (auto& [part, list] : large_of_part) {
+        if (list.size() < 2) continue;
+        // The largest object keeps the bone's part; the others get new ones while the budget lasts.
+        std::stable_sort(list.begin(), list.end(), [](const Object* l, const Object* r) { return l->vertices.size() > r->vertices.size(); });
+        std::vector<int> label(list.size(), part);
+        for (std::size_t i = 1; i < list.size(); ++i) {
+            if (budget > 0 && parts >= budget) break;
+            label[i] = parts++;
+            bone_of_part.push_back(bone_of_part[static_cast<std::size_t>(part)]);
+        }
+        // Every rigid vertex of the part goes with the nearest large object.
+        for (const auto& [key, o] : objects) {
+            if (o.part != part) continue;
+            std::size_t nearest = 0;
+            float best = std::numeric_limits<float>::max();
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const float d = list[i] == &o ? -1.f : list[i]->box.exteriorDistance(o.box.center());
+                if (d < best) { best = d; nearest = i; }
+            }
+            for (std::size_t v : o.vertices) part_of_vertex[v] = label[nearest];
+        }
+    }
+}
+
 }  // namespace
 
 Result<void> validate(const FitOptions& o) {
     if (!(o.min_cluster_fraction >= 0 && o.min_cluster_fraction < 1)) return fail("fit.min_cluster_fraction: must be in [0, 1)");
     if (!(o.min_cluster_size >= 0 && o.min_cluster_size < 1)) return fail("fit.min_cluster_size: must be in [0, 1)");
-    if (!(o.cluster_coverage > 0 && o.cluster_coverage <= 1)) return fail("fit.cluster_coverage: must be in (0, 1]");
+    if (!(o.tolerance_m > 0 && o.tolerance_m <= 1)) return fail("fit.tolerance_m: must be in (0, 1] m");
+    if (!(o.bulge_limit_m > 0 && o.bulge_limit_m <= 1)) return fail("fit.bulge_limit_m: must be in (0, 1] m");
+    if (!(o.sample_spacing > 0 && o.sample_spacing <= 0.5)) return fail("fit.sample_spacing: must be in (0, 0.5]");
     if (!(o.min_radius_m > 0 && std::isfinite(o.min_radius_m))) return fail("fit.min_radius_m: must be > 0");
     if (o.max_ellipsoids < 0) return fail("fit.max_ellipsoids: must be >= 0 (0: no limit)");
     return {};
@@ -194,7 +314,8 @@ std::vector<int> dominant_bones(const MeshAsset& mesh) {
 
 std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
                                            const FitOptions& options,
-                                           std::span<const std::shared_ptr<const AnimationClip>> clips) {
+                                           std::span<const std::shared_ptr<const AnimationClip>> clips,
+                                           std::span<const MeshInfo> meshes) {
     const std::size_t bones = skeleton.size();
     const std::size_t n = mesh.vertex_count();
     std::vector<std::vector<Eigen::Index>> clusters(bones);
@@ -235,6 +356,10 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
     // the first of them.
     auto region_of = [&](std::size_t b) { return region_from_bone_name(skeleton.bone_names[b]); };
     auto extremity = [](BodyRegion r) { return r == BodyRegion::hand || r == BodyRegion::foot; };
+    auto limb = [](BodyRegion r) {
+        return r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::upper_leg ||
+               r == BodyRegion::lower_leg || r == BodyRegion::foot;
+    };
     auto move = [&](std::size_t from, std::size_t to) {
         auto& target = clusters[to];
         target.insert(target.end(), clusters[from].begin(), clusters[from].end());
@@ -283,9 +408,7 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
             const auto pa = static_cast<std::size_t>(a);
             std::vector<Eigen::Index> both = clusters[pa];
             both.insert(both.end(), clusters[b].begin(), clusters[b].end());
-            const double added = volume(fit_cluster(mesh, frame[pa], both, options)) -
-                                 volume(fit_cluster(mesh, frame[pa], clusters[pa], options)) -
-                                 volume(fit_cluster(mesh, frame[b], clusters[b], options));
+            const double added = cluster_volume(mesh, both) - cluster_volume(mesh, clusters[pa]) - cluster_volume(mesh, clusters[b]);
             // Motion between b and its ancestor: every joint on the way moves the cluster.
             double moves = 0;
             for (std::size_t j = b; j != pa; j = static_cast<std::size_t>(skeleton.parents[j])) moves = std::max(moves, motion[j]);
@@ -305,27 +428,87 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
         }
     }
 
+    // Parts: the surviving clusters. Their skin at the rest pose is sampled and fitted.
+    std::vector<int> part_of_bone(bones, -1), bone_of_part;
+    for (std::size_t b = 0; b < bones; ++b)
+        if (fitted(b)) {
+            part_of_bone[b] = static_cast<int>(bone_of_part.size());
+            bone_of_part.push_back(static_cast<int>(b));
+        }
+    std::vector<int> part_of_vertex(n, -1);
+    for (std::size_t b = 0; b < bones; ++b)
+        if (fitted(b))
+            for (Eigen::Index j : clusters[b]) part_of_vertex[static_cast<std::size_t>(j)] = part_of_bone[b];
+    const std::size_t bone_parts = bone_of_part.size();
+    split_rigid_objects(mesh, meshes, height_m, static_cast<int>(bone_parts) + 4 <= options.max_ellipsoids || options.max_ellipsoids == 0
+                                                    ? options.max_ellipsoids - 4 : 0,
+                        part_of_vertex, bone_of_part);
+    std::vector<fitting::PartInfo> part_info(bone_of_part.size());
+    for (std::size_t p = 0; p < bone_parts; ++p) {
+        const int partner = skeleton.find(mirror_name(skeleton.bone_names[static_cast<std::size_t>(bone_of_part[p])]));
+        if (partner >= 0 && partner != bone_of_part[p]) part_info[p].mirror = part_of_bone[static_cast<std::size_t>(partner)];
+        part_info[p].may_split = !limb(region_of(static_cast<std::size_t>(bone_of_part[p])));
+    }
+
+    std::vector<Affine3> global, skinning;
+    compose_pose(skeleton, skeleton.rest_local, global);
+    skinning_matrices(skeleton, global, skinning);
+    Matrix3X positions, normals;
+    skin_mesh(mesh, skinning, Affine3::Identity(), positions, normals);
+    const std::vector<SkinSample> samples = sample_skin(positions, normals, mesh.indices, options.sample_spacing * double(height_m));
+    std::vector<int> part_of(samples.size(), -1);
+    for (std::size_t s = 0; s < samples.size(); ++s) part_of[s] = part_of_vertex[samples[s].vertex];
+
+    fitting::SolverSettings settings;
+    settings.coverage_tolerance_m = options.tolerance_m;
+    settings.cover_margin_m = 0.5 * options.tolerance_m;
+    settings.bulge_limit_m = options.bulge_limit_m;
+    settings.min_radius_m = options.min_radius_m;
+    settings.max_pieces = options.max_ellipsoids > 0 ? options.max_ellipsoids : 1 << 20;
+    const SkinSurface skin(positions, normals, mesh.indices);
+    std::vector<fitting::Piece> pieces = fitting::fit_pieces(skin, samples, part_of, part_info, settings);
+    // Grouped by bone, in the order of the skeleton; a bone's pieces in the order they came.
+    std::stable_sort(pieces.begin(), pieces.end(), [](const auto& l, const auto& r) { return l.part < r.part; });
+
     std::vector<EllipsoidShape> shapes;
-    for (std::size_t b = 0; b < bones; ++b) {
-        if (!fitted(b)) continue;
-        EllipsoidShape shape = fit_cluster(mesh, frame[b], clusters[b], options);
+    for (const fitting::Piece& piece : pieces) {
+        const auto b = static_cast<std::size_t>(bone_of_part[static_cast<std::size_t>(piece.part)]);
+        // Bone space: the rigid part of the bone's rest transform (scale-free, metres).
+        const Eigen::Isometry3d to_bone = Eigen::Isometry3d(rigid_part(global[b]).matrix().cast<double>()).inverse();
+        EllipsoidShape shape;
         shape.bone = static_cast<int>(b);
+        shape.center = (to_bone * piece.shape.center).cast<Real>();
+        shape.rotation = Quat(Eigen::Quaterniond(to_bone.linear() * piece.shape.axes).normalized().cast<Real>());
+        shape.radii_m = piece.shape.radii.cast<Real>().cwiseMax(static_cast<Real>(options.min_radius_m));
         shape.region = holds_hip[b] ? BodyRegion::pelvis : region_from_bone_name(skeleton.bone_names[b]);
+        // A leg keeps the ellipsoid that bounds its bone's vertices unless asked to hug:
+        // see FitOptions::hug_legs.
+        if (!options.hug_legs && (shape.region == BodyRegion::upper_leg || shape.region == BodyRegion::lower_leg) &&
+            static_cast<std::size_t>(piece.part) < bone_parts) {
+            std::vector<Eigen::Index> own;
+            for (std::size_t j = 0; j < n; ++j)
+                if (part_of_vertex[j] == piece.part) own.push_back(static_cast<Eigen::Index>(j));
+            const BodyRegion region = shape.region;
+            shape = bounding_ellipsoid(mesh, rigid_part(skeleton.inverse_bind[b].inverse()), own, options.min_radius_m);
+            shape.bone = static_cast<int>(b);
+            shape.region = region;
+        }
         shapes.push_back(shape);
     }
     // No cluster holds the hip bone's vertices (a rig whose pelvis mesh hangs from a
-    // sibling bone): the trunk ellipsoid nearest the hip joint stands for the pelvis.
+    // sibling bone): the trunk ellipsoids nearest the hip joint stand for the pelvis.
     const bool has_pelvis = std::any_of(shapes.begin(), shapes.end(), [](auto& s) { return s.region == BodyRegion::pelvis; });
     if (!has_pelvis && hip >= 0) {
-        const Vec3 hip_at = frame[static_cast<std::size_t>(hip)].translation();
-        EllipsoidShape* nearest = nullptr;
+        const Vec3 hip_at = global[static_cast<std::size_t>(hip)].translation();
+        int nearest = -1;
         Real best = std::numeric_limits<Real>::max();
-        for (EllipsoidShape& s : shapes) {
+        for (const EllipsoidShape& s : shapes) {
             if (s.region != BodyRegion::other && s.region != BodyRegion::torso) continue;
-            const Real d = (frame[static_cast<std::size_t>(s.bone)] * s.center - hip_at).norm();
-            if (d < best) { best = d; nearest = &s; }
+            const Real d = (rigid_part(global[static_cast<std::size_t>(s.bone)]) * s.center - hip_at).norm();
+            if (d < best) { best = d; nearest = s.bone; }
         }
-        if (nearest != nullptr) nearest->region = BodyRegion::pelvis;
+        for (EllipsoidShape& s : shapes)
+            if (s.bone == nearest) s.region = BodyRegion::pelvis;
     }
     return shapes;
 }
@@ -339,14 +522,21 @@ Affine3 ellipsoid_transform(const EllipsoidShape& shape, const Affine3& bone_glo
 }
 
 Real outside_distance(const Affine3& e, const Vec3& point) {
-    const Vec3 u = e.inverse(Eigen::Affine) * point;
-    const Real r = u.norm();
-    if (r <= 1) return 0;
-    return (point - e * Vec3(u / r)).norm();
+    // Unit sphere -> space: the linear part's columns are the axes scaled by the radii.
+    Eigen::Vector3d radii;
+    Eigen::Matrix3d axes;
+    for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d column = e.linear().col(k).cast<double>();
+        radii[k] = column.norm();
+        axes.col(k) = radii[k] > 0 ? Eigen::Vector3d(column / radii[k]) : Eigen::Vector3d::Unit(k);
+    }
+    const Eigen::Vector3d q = axes.transpose() * (point - e.translation()).cast<double>();
+    return static_cast<Real>(fitting::outside_distance(radii.cwiseMax(1e-12), q));
 }
 
 CoverageReport measure_coverage(std::span<const EllipsoidShape> shapes, std::span<const Affine3> global,
-                                const Matrix3X& positions, const Matrix3X& normals, double tolerance_m) {
+                                const Matrix3X& positions, const Matrix3X& normals, std::span<const std::uint32_t> triangles,
+                                double tolerance_m) {
     CoverageReport report;
     report.tolerance_m = tolerance_m;
     report.vertices = static_cast<std::size_t>(positions.cols());
@@ -362,11 +552,7 @@ CoverageReport measure_coverage(std::span<const EllipsoidShape> shapes, std::spa
         for (Eigen::Index j = r.begin(); j < r.end(); ++j) {
             Real best = std::numeric_limits<Real>::infinity();
             const Vec3 p = positions.col(j);
-            for (std::size_t k = 0; k < e.size() && best > 0; ++k) {
-                const Vec3 u = e_inverse[k] * p;
-                const Real len = u.norm();
-                best = std::min(best, len <= 1 ? Real(0) : (p - e[k] * Vec3(u / len)).norm());
-            }
+            for (std::size_t k = 0; k < e.size() && best > 0; ++k) best = std::min(best, outside_distance(e[k], p));
             gap[static_cast<std::size_t>(j)] = best;
         }
     });
@@ -376,32 +562,61 @@ CoverageReport measure_coverage(std::span<const EllipsoidShape> shapes, std::spa
     }
     report.coverage = report.vertices ? double(report.covered) / double(report.vertices) : 0;
 
-    // Bulge: surface samples against the nearest vertex and its outward normal.
-    const Matrix3X unit = sphere_samples(192);
-    report.bulge_per_ellipsoid_m.assign(e.size(), 0);
-    std::vector<std::vector<Real>> bulges(e.size());
+    // Bulge on the union's surface: samples of each ellipsoid that no other ellipsoid
+    // holds, against the closest point of the skin's triangles.
+    const SkinSurface skin(positions, normals, triangles);
+    const Matrix3X unit = sphere_samples(bulge_samples_per_ellipsoid);
+    struct Sample {
+        double bulge_m;  // < 0: inside the skin
+        double area_m2;
+    };
+    std::vector<std::vector<Sample>> per(e.size());
     tbb::parallel_for(std::size_t(0), e.size(), [&](std::size_t k) {
-        const Matrix3X samples = (e[k].linear().lazyProduct(unit)).colwise() + e[k].translation();
-        auto& out = bulges[k];
-        for (Eigen::Index s = 0; s < samples.cols(); ++s) {
-            Eigen::Index nearest = 0;
-            (positions.colwise() - samples.col(s)).colwise().squaredNorm().minCoeff(&nearest);
-            const Real outward = (samples.col(s) - positions.col(nearest)).dot(normals.col(nearest));
-            if (outward > 0) out.push_back(outward);
+        const Vec3 radii(e[k].linear().col(0).norm(), e[k].linear().col(1).norm(), e[k].linear().col(2).norm());
+        for (Eigen::Index s = 0; s < unit.cols(); ++s) {
+            const Vec3 u = unit.col(s);
+            const Vec3 x = e[k] * u;
+            bool buried = false;
+            for (std::size_t other = 0; other < e.size() && !buried; ++other)
+                buried = other != k && (e_inverse[other] * x).squaredNorm() < Real(1 - 1e-6);
+            if (buried) continue;
+            // Area element of the unit sphere mapped onto the ellipsoid: r1 r2 r3 |u / r|.
+            const double area = 4 * std::numbers::pi / double(unit.cols()) * double(radii.prod()) * double(u.cwiseQuotient(radii).norm());
+            const SkinSurface::Closest c = skin.closest(x.cast<double>());
+            if (c.triangle < 0) continue;
+            per[k].push_back({c.outside ? c.distance_m : -c.distance_m, area});
         }
     });
-    std::vector<Real> all;
-    for (std::size_t k = 0; k < e.size(); ++k) {
-        for (Real b : bulges[k]) report.bulge_per_ellipsoid_m[k] = std::max(report.bulge_per_ellipsoid_m[k], double(b));
-        all.insert(all.end(), bulges[k].begin(), bulges[k].end());
-    }
-    if (!all.empty()) {
-        double sum = 0;
-        for (Real b : all) sum += b;
-        report.mean_bulge_m = sum / double(all.size());
-        std::sort(all.begin(), all.end());
-        report.p95_bulge_m = all[std::min(all.size() - 1, static_cast<std::size_t>(0.95 * double(all.size())))];
-        report.max_bulge_m = all.back();
+    report.bulge_per_ellipsoid_m.assign(e.size(), 0);
+    std::vector<Sample> out;
+    double surface = 0;
+    for (std::size_t k = 0; k < e.size(); ++k)
+        for (const Sample& s : per[k]) {
+            surface += s.area_m2;
+            if (s.bulge_m <= 0) continue;
+            report.bulge_per_ellipsoid_m[k] = std::max(report.bulge_per_ellipsoid_m[k], s.bulge_m);
+            out.push_back(s);
+        }
+    report.surface_m2 = surface;
+    if (!out.empty()) {
+        std::sort(out.begin(), out.end(), [](const Sample& l, const Sample& r) { return l.bulge_m < r.bulge_m; });
+        double area = 0, weighted = 0;
+        for (const Sample& s : out) {
+            area += s.area_m2;
+            weighted += s.area_m2 * s.bulge_m;
+        }
+        report.outside_share = surface > 0 ? area / surface : 0;
+        report.mean_bulge_m = weighted / area;
+        double below = 0;
+        report.p95_bulge_m = out.back().bulge_m;
+        for (const Sample& s : out) {
+            below += s.area_m2;
+            if (below >= 0.95 * area) {
+                report.p95_bulge_m = s.bulge_m;
+                break;
+            }
+        }
+        report.max_bulge_m = out.back().bulge_m;
     }
     return report;
 }

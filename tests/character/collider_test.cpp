@@ -114,7 +114,7 @@ TEST(EllipsoidFitting, CoversTheTestColumnAndTagsNothingAsPelvis) {
     skinning_matrices(*c->skeleton, global, skinning);
     Matrix3X p, n;
     skin_mesh(*c->mesh, skinning, Affine3::Identity(), p, n);
-    const CoverageReport r = measure_coverage(body.ellipsoids, global, p, n);
+    const CoverageReport r = measure_coverage(body.ellipsoids, global, p, n, c->mesh->indices);
     EXPECT_GE(r.coverage, 0.95);
     EXPECT_EQ(find_hip_bone(*c->skeleton), -1);  // "Root" and "Child" are no hips
     EXPECT_EQ(body.hip_bone, -1);
@@ -128,10 +128,10 @@ TEST(EllipsoidFitting, BadOptionsNameTheFileAndTheField) {
     const auto c = column();
     ASSERT_TRUE(c);
     FitOptions bad;
-    bad.cluster_coverage = 0;
+    bad.tolerance_m = 0;
     const auto body = fit_character_body(*c, bad);
     ASSERT_FALSE(body);
-    EXPECT_EQ(body.error().message, c->source.string() + ": fit.cluster_coverage: must be in (0, 1]");
+    EXPECT_EQ(body.error().message, c->source.string() + ": fit.tolerance_m: must be in (0, 1] m");
 }
 
 TEST(EllipsoidFitting, HipBoneIsFoundByNameOrByTheLegs) {
