@@ -282,15 +282,23 @@ TEST(DefaultAvatar, ImportsLikeAnyCharacter) {
     EXPECT_EQ(body->hip_bone, c.skeleton->find("Hips"));
 }
 
-// The ellipsoids hug the body: 99 % of the skin within 1 cm of them, and 95 % of their
-// surface that stands out of the skin no more than 2 cm out; within a garment's 64
-// colliders and the fit's budget; one ellipsoid per leg bone.
-void expect_hugging_ellipsoids(const CharacterAsset& c, const std::string& what) {
-    SCOPED_TRACE(what);
-    const auto body = fit_character_body(c);
+// The fitted ellipsoids: within a garment's 64 colliders and the fit's budget, one
+// ellipsoid per leg bone, a pelvis. Fitted with the legs tight too (FitOptions::hug_legs),
+// they hug the body to the target: 99 % of the skin within 1 cm of them and 95 % of their
+// surface that stands out of the skin no more than 2 cm out. The default fit keeps the legs'
+// bounding ellipsoids, because the cloth traps its hem between tight legs (docs/cloth.md,
+// "Known limits"): there the target is missed and the bound below guards the rest of the
+// fit (a trunk or arm piece floating off the body would break it).
+constexpr double default_fit_p95_bulge_bound_m = 0.08;
+
+void expect_fitted_ellipsoids(const CharacterAsset& c, const std::string& what, bool hug_legs) {
+    SCOPED_TRACE(what + (hug_legs ? ", legs hugged" : ", default fit"));
+    FitOptions options;
+    options.hug_legs = hug_legs;
+    const auto body = fit_character_body(c, options);
     ASSERT_TRUE(body) << body.error().message;
     EXPECT_GE(body->ellipsoids.size(), 12u);
-    EXPECT_LE(body->ellipsoids.size(), std::size_t(FitOptions{}.max_ellipsoids));
+    EXPECT_LE(body->ellipsoids.size(), std::size_t(options.max_ellipsoids));
     EXPECT_LE(body->ellipsoids.size(), 64u);
     auto count = [&](BodyRegion r) { return std::count_if(body->ellipsoids.begin(), body->ellipsoids.end(), [&](auto& e) { return e.region == r; }); };
     EXPECT_EQ(count(BodyRegion::upper_leg), 2);
@@ -299,7 +307,12 @@ void expect_hugging_ellipsoids(const CharacterAsset& c, const std::string& what)
     EXPECT_TRUE(body->landmarks) << body->landmarks_error;
     const CoverageReport coverage = rest_pose_coverage(c, *body);
     EXPECT_GE(coverage.coverage, 0.99) << "largest gap " << coverage.max_gap_m << " m";
-    EXPECT_LE(coverage.p95_bulge_m, 0.02) << "max bulge " << coverage.max_bulge_m << " m";
+    EXPECT_LE(coverage.p95_bulge_m, hug_legs ? 0.02 : default_fit_p95_bulge_bound_m) << "max bulge " << coverage.max_bulge_m << " m";
+}
+
+void expect_hugging_ellipsoids(const CharacterAsset& c, const std::string& what) {
+    expect_fitted_ellipsoids(c, what, true);
+    expect_fitted_ellipsoids(c, what, false);
 }
 
 TEST(DefaultAvatar, FittedEllipsoidsHugTheBody) {
