@@ -18,7 +18,7 @@ namespace bench {
 
 const std::vector<Benchmark>& benchmarks() {
     static const std::vector<Benchmark> list = {
-        {"table1", "the paper's Table 1: classic + brute force vs simplified + candidate lists", run_table1},
+        {"table1", "the paper's Table 1: model (classic, simplified) x collision (brute force, candidate lists) at equal substeps", run_table1},
         {"error", "error against run time over model x substeps x iterations x collision; analytic references", run_error},
         {"stability", "stiffness x frame time x motion x garment, with and without automatic substeps", run_stability},
         {"scale", "garment size, walker count and threads; microseconds per particle per frame", run_scale},

@@ -8,13 +8,9 @@
 //   the 2 x 2 of model (classic | simplified) x collision (brute force | candidate lists),
 //   every one at the same fixed substeps per frame (`table_substeps`), and
 //   the shipped configuration (simplified + candidate lists, automatic substeps).
-// Both collision modes run through the same detection code, the 64-particle vector test of
-// the candidate-list path (systems/cloth/collision.hpp, step 2): brute force is that path
-// with lists that hold every ellipsoid (a candidate margin of a kilometre), so every free
-// particle is tested against every ellipsoid and every contact is re-tested against all of
-// them, as in brute force. That path also keeps its lists up to date each collision round;
-// nothing is refreshed with such a margin, but the bookkeeping costs time, which is measured
-// by running it once more after each round and subtracted from the brute-force rows.
+// Both collision modes run through the same detection and response code, the 64-particle
+// vector test (systems/cloth/collision.hpp, step 2): brute force lists every ellipsoid for
+// every free particle and keeps no lists.
 // Collision tests (detection and re-tests) come from the garment's counters on one basis in
 // both modes; the lists' own upkeep tests are counted apart.
 // Timing: hooks around each collision round and the end-of-substep check give "collide";
@@ -41,9 +37,6 @@ constexpr int measured_frames = 600;   ///< 10 s: several walk cycles.
 /// Substeps per frame of every row of the 2 x 2: at or above what the automatic rule takes
 /// for the shipped skirt on this walk (the "default" entry reports its mean).
 constexpr int table_substeps = 2;
-/// Candidate margin that lists every ellipsoid for every particle (brute force through the
-/// list path's vector detection).
-constexpr Real everything_listed_margin_m = 1000;
 
 struct Config {
     ClothModel model;
@@ -68,8 +61,7 @@ struct Timed {
     Garment garment;
     GarmentSolver solver;
     ClothSolverSettings settings;
-    bool everything_listed = false;
-    std::int64_t total_ns = 0, collide_ns = 0, bookkeeping_ns = 0;
+    std::int64_t total_ns = 0, collide_ns = 0;
     std::int64_t substeps = 0, stability_need = 0, motion_need = 0;
 };
 
@@ -78,61 +70,47 @@ Timed make_timed(const Garment& base, const Config& c) {
     Timed t;
     t.garment = base;
     t.garment.config.model = c.model;
-    t.garment.config.collision = CollisionMode::candidate_lists;
-    if (c.collision == CollisionMode::brute_force) {
-        t.garment.config.material.candidate_margin_m = everything_listed_margin_m;
-        t.everything_listed = true;
-    }
+    t.garment.config.collision = c.collision;
     if (c.fixed) t.settings.fixed_substeps = table_substeps;
     return t;
 }
 
 /// One fixed step of a timed garment against the registry's colliders.
 void step_timed(const Registry& registry, Timed& t) {
-    int round = 0;
     StepHooks hooks;
     hooks.collide_round = [&](Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
         const std::int64_t a = now_ns();
-        collide_round(registry, g, s, sub, round++);
-        const std::int64_t b = now_ns();
-        t.collide_ns += b - a;
-        if (t.everything_listed) {
-            // The list bookkeeping collide_round just did, once more (nothing to refresh: the
-            // same work), to subtract it: a brute force keeps no lists.
-            update_candidate_lists(g, s);
-            t.bookkeeping_ns += now_ns() - b;
-        }
+        collide_round(registry, g, s, sub, 0);
+        t.collide_ns += now_ns() - a;
     };
     hooks.finish_collision = [&](Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
         const std::int64_t a = now_ns();
         finish_collision(registry, g, s, sub);
         t.collide_ns += now_ns() - a;
     };
-    hooks.after_constraints = [&](Garment&, GarmentSolver&, const ClothSubstep&) { round = 0; };
-    const std::int64_t bookkeeping_before = t.bookkeeping_ns;
     const std::int64_t start = now_ns();
     t.substeps += step_garment(registry, t.garment, t.solver, frame_dt_s, t.settings, hooks);
-    t.total_ns += now_ns() - start - (t.bookkeeping_ns - bookkeeping_before);
+    t.total_ns += now_ns() - start;
     t.stability_need += t.garment.counters.substeps_stability;
     t.motion_need += t.garment.counters.substeps_motion;
 }
 
 /// Per-frame figures of one configuration over one run's window.
 struct Figures {
-    double integrate_ms = 0, collide_ms = 0, total_ms = 0, bookkeeping_ms = 0;
+    double integrate_ms = 0, collide_ms = 0, total_ms = 0;
     double tests = 0, upkeep_tests = 0, collisions = 0;
     double substeps = 0, stability_need = 0, motion_need = 0;
 };
 
 struct Window {
-    std::int64_t total_ns, collide_ns, bookkeeping_ns, substeps, stability_need, motion_need;
+    std::int64_t total_ns, collide_ns, substeps, stability_need, motion_need;
     std::uint64_t tests, upkeep_tests, collisions;
 };
 
 Window mark(const Timed& t) {
     const GarmentCounters& c = t.garment.counters;
-    return {t.total_ns,  t.collide_ns, t.bookkeeping_ns,   t.substeps,   t.stability_need,
-            t.motion_need, c.collision_tests, c.list_rebuild_tests, c.collisions};
+    return {t.total_ns, t.collide_ns, t.substeps, t.stability_need, t.motion_need, c.collision_tests, c.list_rebuild_tests,
+            c.collisions};
 }
 
 Figures per_frame_figures(const Timed& t, const Window& w, int frames) {
@@ -140,8 +118,6 @@ Figures per_frame_figures(const Timed& t, const Window& w, int frames) {
     Figures r;
     r.total_ms = 1e-6 * static_cast<double>(t.total_ns - w.total_ns) * f;
     r.collide_ms = 1e-6 * static_cast<double>(t.collide_ns - w.collide_ns) * f;
-    r.bookkeeping_ms = 1e-6 * static_cast<double>(t.bookkeeping_ns - w.bookkeeping_ns) * f;
-    r.collide_ms -= r.bookkeeping_ms;
     r.integrate_ms = r.total_ms - r.collide_ms;
     const GarmentCounters& c = t.garment.counters;
     r.tests = static_cast<double>(c.collision_tests - w.tests) * f;
@@ -162,16 +138,11 @@ Figures median_figures(const std::vector<Figures>& runs) {
     };
     Figures m;
     for (double Figures::*field : {&Figures::integrate_ms, &Figures::collide_ms, &Figures::total_ms,
-                                   &Figures::bookkeeping_ms, &Figures::tests, &Figures::upkeep_tests,
+                                   &Figures::tests, &Figures::upkeep_tests,
                                    &Figures::collisions, &Figures::substeps, &Figures::stability_need,
                                    &Figures::motion_need})
         m.*field = med(field);
     return m;
-}
-
-/// Largest distance between two garments' particles, m.
-double largest_gap_m(const Garment& a, const Garment& b) {
-    return static_cast<double>((a.state.x - b.state.x).colwise().norm().maxCoeff());
 }
 
 nlohmann::json row_json(const Config& c, const Figures& f, double substeps) {
@@ -198,7 +169,7 @@ std::string percent(double ratio) { return fixed(100 * ratio, 1) + " %"; }
 Result<void> run_table1(const BenchOptions& options) {
     const Machine machine = describe_machine();
     std::vector<Figures> samples[configs.size()];
-    std::vector<double> body_ms, rule_brute_force_substeps, check_gap_m, check_tests_ratio;
+    std::vector<double> body_ms;
     std::size_t particles = 0, ellipsoids = 0, bones = 0, garment_colliders = 0;
     int rounds = 0;
 
@@ -210,24 +181,11 @@ Result<void> run_table1(const BenchOptions& options) {
         const Garment base = first_garment(*world);
         std::vector<Timed> timed;
         for (const Config& c : configs) timed.push_back(make_timed(base, c));
-        // Two more, not timed: the solver's own (scalar) brute force at the table's substeps,
-        // to check over the settling frames that the vector path detects the same contacts;
-        // and the solver's brute-force mode with automatic substeps, for what its rule takes.
-        Timed check = make_timed(base, configs[2]);
-        check.garment.config.collision = CollisionMode::brute_force;
-        check.garment.config.material = base.config.material;
-        check.everything_listed = false;
-        Timed rule_probe = make_timed(base, configs[shipped]);
-        rule_probe.garment.config.collision = CollisionMode::brute_force;
 
         ClothSystemTime body_start;
         std::vector<Window> start(configs.size());
-        int probe_substeps = 0;
         for (int frame = 0; frame < settle_frames + measured_frames; ++frame) {
             if (frame == settle_frames) {
-                check_gap_m.push_back(largest_gap_m(check.garment, timed[2].garment));
-                const double scalar_tests = static_cast<double>(check.garment.counters.collision_tests);
-                check_tests_ratio.push_back(scalar_tests > 0 ? static_cast<double>(timed[2].garment.counters.collision_tests) / scalar_tests : NAN);
                 body_start = cloth_system_totals(world->scheduler);
                 for (std::size_t c = 0; c < configs.size(); ++c) start[c] = mark(timed[c]);
             }
@@ -237,18 +195,10 @@ Result<void> run_table1(const BenchOptions& options) {
                 return fail("table1: frame " + std::to_string(frame) + " took " + std::to_string(stepped->steps) +
                             " fixed steps (expected one per 1/60 s frame)");
             for (std::size_t k = 0; k < configs.size(); ++k) step_timed(world->registry, timed[(k + frame) % configs.size()]);
-            if (frame < settle_frames) {
-                step_timed(world->registry, check);
-            } else {
-                const std::int64_t before = rule_probe.substeps;
-                step_timed(world->registry, rule_probe);
-                probe_substeps += static_cast<int>(rule_probe.substeps - before);
-            }
         }
         for (std::size_t c = 0; c < configs.size(); ++c) samples[c].push_back(per_frame_figures(timed[c], start[c], measured_frames));
         const ClothSystemTime body = per_frame(cloth_system_totals(world->scheduler), body_start, measured_frames);
         body_ms.push_back(body.animation_ms + body.skinning_ms);
-        rule_brute_force_substeps.push_back(static_cast<double>(probe_substeps) / measured_frames);
         if (run == 0) {
             particles = static_cast<std::size_t>(base.state.x.cols());
             garment_colliders = base.body.colliders.size();
@@ -271,8 +221,6 @@ Result<void> run_table1(const BenchOptions& options) {
     const double collide_ratio_classic = classic_lists.collide_ms / classic_bf.collide_ms;
     const double paper_pair_integrate = simplified_lists.integrate_ms / classic_bf.integrate_ms;
     const double paper_pair_collide = simplified_lists.collide_ms / classic_bf.collide_ms;
-    const double gap_mm = 1000 * median(check_gap_m);
-    const double tests_ratio = median(check_tests_ratio);
 
     nlohmann::json json;
     json["particles"] = particles;
@@ -285,10 +233,6 @@ Result<void> run_table1(const BenchOptions& options) {
     json["default"]["substeps"] = "automatic";
     json["default"]["stability_need_per_frame"] = shipped_figures.stability_need;
     json["default"]["motion_need_per_frame"] = shipped_figures.motion_need;
-    json["brute_force_rule_substeps_per_frame"] = median(rule_brute_force_substeps);
-    json["brute_force_bookkeeping_subtracted_ms"] = {{"classic", classic_bf.bookkeeping_ms},
-                                                     {"simplified", simplified_bf.bookkeeping_ms}};
-    json["brute_force_check"] = {{"largest_gap_m", gap_mm / 1000}, {"tests_vector_over_scalar", tests_ratio}};
     json["ratios"] = {{"integrate_simplified_over_classic_lists", integrate_ratio_lists},
                       {"integrate_simplified_over_classic_brute_force", integrate_ratio_bf},
                       {"collide_lists_over_brute_force_simplified", collide_ratio_simplified},
@@ -308,18 +252,14 @@ Result<void> run_table1(const BenchOptions& options) {
         " frames settle, then " + std::to_string(measured_frames) + " frames are timed; figures are per-frame means "
         "of each run, then medians over " + std::to_string(options.runs) + " runs. One worker thread.");
     report.paragraph(
-        "**Collide** is the collision rounds (" + std::to_string(rounds) + " per substep, each after a "
-        "constraint round) and the end-of-substep check, timed by hooks around them; **integrate** is the rest of "
-        "the step: substep rule, pins, eq. 2 prediction, collider frames, the constraint rounds (springs, Provot's "
-        "limit, tethers; the paper's integration holds its constraints, method §4) and the velocities. Both "
-        "collision modes run through the same detection code, the candidate-list path's 64-particle vector test: "
-        "**brute force** is that path with lists that hold every ellipsoid (a 1 km candidate margin), so every free "
-        "particle is tested against every ellipsoid and every contact is re-tested against all of them. That path "
-        "still does its list bookkeeping each round (nothing is ever refreshed with such a margin); it is timed by "
-        "running it once more after each round and subtracted: " + fixed(classic_bf.bookkeeping_ms, 4) +
-        " ms per frame for the classic row, " + fixed(simplified_bf.bookkeeping_ms, 4) + " ms for the simplified. "
-        "Check: over the settling frames the solver's own brute-force mode (a scalar loop) and this path stay "
-        "within " + fixed(gap_mm, 3) + " mm of each other, with " + fixed(tests_ratio, 4) + "x its collision tests.");
+        "**Collide** is the collision rounds (" + std::to_string((rounds + 1) / 2) + " per substep, after every "
+        "second of the " + std::to_string(rounds) + " constraint rounds) and the end of the substep (the last "
+        "collision of what the warp limit moved, the velocities, the non-finite check), timed by hooks around them; "
+        "**integrate** is the rest of the step: substep rule, pins, eq. 2 prediction, collider frames, the constraint "
+        "rounds (springs, Provot's limit, tethers, the warp limit; the paper's integration holds its constraints, "
+        "method §4). Both collision modes run through the same detection and response code, the 64-particle vector "
+        "test: **brute force** lists every ellipsoid for every free particle and keeps no lists, **candidate lists** "
+        "list the ellipsoids within the margin of each particle and keep them exact (collision.hpp step 1).");
     report.paragraph(
         "**Collision tests** are unit-sphere tests, detection and re-tests, from the garment's counters, on one basis "
         "in both modes; **upkeep tests** are the candidate lists' own (the broad phase that keeps them exact, "
@@ -353,9 +293,8 @@ Result<void> run_table1(const BenchOptions& options) {
         fixed(shipped_figures.collide_ms, 4) + " ms, total **" + fixed(shipped_figures.total_ms, 4) + " ms**; " +
         fixed(shipped_figures.tests, 0) + " collision tests and " + fixed(shipped_figures.upkeep_tests, 0) +
         " upkeep tests per frame. Animation and collider update of the body: " + fixed(median(body_ms), 4) +
-        " ms per frame. For comparison only (not a row of the table): the same rule with the solver's brute-force "
-        "mode takes " + fixed(median(rule_brute_force_substeps), 2) +
-        " substeps per frame, since in that mode it counts the travel of every collider, reachable or not.");
+        " ms per frame. The rule counts the colliders whose box comes within the candidate margin of the "
+        "garment's box, in both collision modes.");
 
     report.heading("Against the paper (Pentium 4 3.0 GHz, Java3D)");
     report.paragraph("The paper's Table 1 pairs classic + brute force with simplified + candidate lists; its ratios are "
