@@ -177,8 +177,9 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
         }
 }
 
-// The warp limit moved particles after the last collision round (on the walk, most of them
-// by a millimetre or more): each block of 64 particles holding one is collided again, in
+// The warp limit moved particles after the last collision round (on the sample scene's walk
+// 153 of 837 per substep, 61 of them by a millimetre or more): each block of 64 particles
+// holding one is collided again, in
 // the garment's collision mode (the lists brought up to date first), positions only; the
 // last round's contacts are kept.
 void collide_warp_moves(Garment& g, GarmentSolver& s) {
