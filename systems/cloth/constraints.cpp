@@ -111,10 +111,9 @@ VectorX warp_rest_above(const Fabric& f) {
     return above;
 }
 
-Tethers build_tethers(const Fabric& f, const VectorX& w) {
+Tethers build_tethers(const Fabric& f, const VectorX& w, const VectorX& above) {
     Tethers t;
     const std::uint32_t m = f.particles_per_line;
-    const VectorX above = warp_rest_above(f);
     for (std::uint32_t line = 0; line < f.warp_lines; ++line) {
         std::uint32_t anchor = std::numeric_limits<std::uint32_t>::max();
         Real along = 0;
@@ -170,15 +169,6 @@ void limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX&
             x.col(p) += move;
             moves.col(p) = move;
         }
-}
-
-Real max_strain(const SpringPhase& springs, const Matrix3X& x) {
-    Real worst_sq = 0;
-    for (std::size_t s = 0; s < springs.size(); ++s) {
-        const Real ratio_sq = (x.col(springs.b[s]) - x.col(springs.a[s])).squaredNorm() / (springs.rest_m[s] * springs.rest_m[s]);
-        worst_sq = std::max(worst_sq, ratio_sq);
-    }
-    return worst_sq > 1 ? std::sqrt(worst_sq) - 1 : Real(0);
 }
 
 }  // namespace drape

@@ -69,8 +69,9 @@ struct Tethers {
 [[nodiscard]] VectorX warp_rest_above(const Fabric& fabric);
 
 /// Tethers of every free particle, layer 2 included, from the nearest pinned particle above
-/// it on its warp line; none for a line without a pinned particle.
-[[nodiscard]] Tethers build_tethers(const Fabric& fabric, const VectorX& inv_mass);
+/// it on its warp line; none for a line without a pinned particle. `rest_above`:
+/// warp_rest_above(fabric).
+[[nodiscard]] Tethers build_tethers(const Fabric& fabric, const VectorX& inv_mass, const VectorX& rest_above);
 
 /// One pass over the tethers (step 2).
 void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
@@ -82,8 +83,5 @@ void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 /// that afterwards. `moves` receives each particle's move (zero for the rest).
 void limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real stretch,
                       Matrix3X& x, Matrix3X& moves);
-
-/// Largest length / rest - 1 over `springs` (0 when none is stretched).
-[[nodiscard]] Real max_strain(const SpringPhase& springs, const Matrix3X& x);
 
 }  // namespace drape

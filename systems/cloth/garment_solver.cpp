@@ -86,21 +86,16 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
             s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true));
         }
-        s.tethers = build_tethers(t, state.inv_mass);
         s.warp_rest_above = warp_rest_above(t);
+        s.tethers = build_tethers(t, state.inv_mass, s.warp_rest_above);
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;
         s.built_fabric = &t;
         s.built_pins = state.pins.size();
         s.configured = true;
     }
-    if (s.force.cols() != n) s.force = Matrix3X::Zero(3, n);
     if (s.warp_moves.cols() != n) s.warp_moves = Matrix3X::Zero(3, n);
     if (s.x_round.cols() != n) s.x_round = Matrix3X::Zero(3, n);
-    if (s.movable.size() != static_cast<std::size_t>(n)) {
-        s.movable.resize(static_cast<std::size_t>(n));
-        for (Eigen::Index i = 0; i < n; ++i) s.movable[static_cast<std::size_t>(i)] = state.inv_mass[i] != 0;
-    }
     if (s.last_collided.size() != static_cast<std::size_t>(n)) s.last_collided.assign(static_cast<std::size_t>(n), 0);
     if (s.contacts.size() != static_cast<std::size_t>(n)) s.contacts.assign(static_cast<std::size_t>(n), 0);
 }

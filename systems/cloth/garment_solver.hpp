@@ -77,8 +77,6 @@ struct GarmentSolver {
     std::vector<std::uint64_t> contacts;     ///< Per particle: ellipsoids it touched in this substep's rounds.
     Matrix3X warp_moves;                     ///< Per particle: the warp limit's move this substep.
     std::vector<std::uint64_t> block_collided; ///< Scratch: last_collided of one block of particles.
-    std::vector<std::uint8_t> movable;       ///< Per particle: 1 unless pinned.
-    Matrix3X force;                          ///< Scratch of 3 x particles.
 };
 
 /// Sizes the scratch arrays and masks for `garment` and drops the caches that depend on a
