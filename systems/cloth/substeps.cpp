@@ -3,11 +3,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "components/ellipsoid_collider.hpp"
 #include "systems/cloth/body.hpp"
 
 namespace drape {
+namespace {
+
+// Box of the points: 16 at a time as 48 consecutive coordinates, each lane keeping the
+// least and greatest of its coordinate (lane i holds coordinate i mod 3).
+std::pair<Vec3, Vec3> bounds(const Matrix3X& x) {
+    constexpr Real inf = std::numeric_limits<Real>::infinity();
+    using Lanes = Eigen::Array<Real, 48, 1>;
+    Lanes lo = Lanes::Constant(inf), hi = Lanes::Constant(-inf);
+    const Real* d = x.data();
+    const Eigen::Index n = x.cols();
+    Eigen::Index p = 0;
+    for (; p + 16 <= n; p += 16) {
+        const Eigen::Map<const Lanes> block(d + 3 * p);
+        lo = lo.min(block);
+        hi = hi.max(block);
+    }
+    Vec3 low = Vec3::Constant(inf), high = Vec3::Constant(-inf);
+    for (int i = 0; i < 48; ++i) {
+        low[i % 3] = std::min(low[i % 3], lo[i]);
+        high[i % 3] = std::max(high[i % 3], hi[i]);
+    }
+    for (; p < n; ++p) {
+        low = low.cwiseMin(x.col(p));
+        high = high.cwiseMax(x.col(p));
+    }
+    return {low, high};
+}
+
+}  // namespace
 
 int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver, double fixed_dt,
                      const ClothSolverSettings& s) {
@@ -28,8 +59,9 @@ int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver
         ? registry.try_get<EllipsoidCollider>(body.colliders[static_cast<std::size_t>(body.anchor)]) : nullptr;
     // Colliders the garment can reach: those whose box comes within the candidate margin of
     // the garment's box (the same in both collision modes).
-    const Vec3 low = g.state.x.rowwise().minCoeff().array() - g.config.material.candidate_margin_m;
-    const Vec3 high = g.state.x.rowwise().maxCoeff().array() + g.config.material.candidate_margin_m;
+    const auto [x_low, x_high] = bounds(g.state.x);
+    const Vec3 low = x_low.array() - g.config.material.candidate_margin_m;
+    const Vec3 high = x_high.array() + g.config.material.candidate_margin_m;
     const Vec3 anchor_c = anchor ? Vec3(anchor->world.translation()) : Vec3::Zero();
     for (std::size_t e = 0; e < body.colliders.size() && e < 64; ++e) {
         const auto* c = registry.try_get<EllipsoidCollider>(body.colliders[e]);
