@@ -321,7 +321,7 @@ Divergence run_chain(const Chain& chain, double k, double h) {
             v.col(i) -= hr * inv_mass[i] * f;
             v.col(i - 1) += hr * inv_mass[i - 1] * f;
         }
-        predict_particles(x, v, inv_mass, drag, n, AnchorMotion{}, InertiaScales{}, gravity, hr);
+        predict_particles(x, v, inv_mass, drag, 0, n, AnchorMotion{}, InertiaScales{}, gravity, hr);
         if (!x.allFinite() || !v.allFinite()) {
             trace.non_finite_values = static_cast<std::uint64_t>((!x.array().isFinite()).count() + (!v.array().isFinite()).count());
             trace.first_non_finite_frame = step;

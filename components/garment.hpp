@@ -16,7 +16,10 @@
 //   weft. Every `weft_stride`-th warp line is layer 1 (integrated); the lines between are
 //   layer 2 (placed from their layer-1 neighbours, method §4.2).
 // - Particles are stored layer 1 first: columns [0, layer1_count) of `x` are the layer-1
-//   particles, so the simplified model integrates one contiguous block.
+//   particles, so the simplified model integrates one contiguous block. Within a layer, a
+//   big garment's particles are stored by `line_bands` bands of neighbouring lines, so that
+//   threads working on different bands write different memory
+//   (systems/cloth/garment_parts.hpp).
 // - Springs are flat parallel index arrays (`SpringPhase`). Warp springs are listed line by
 //   line from the fitting zone outward: `a` is the end nearer the pins.
 // - `inv_mass` is the same in both models (1 / (areal density x area), 0 = pinned). In the
@@ -63,6 +66,7 @@ struct Fabric {
     std::uint32_t weft_stride = 1;          ///< Every weft_stride-th line is layer 1.
     bool closed = false;                    ///< The weft wraps around (skirt, dress).
     std::uint32_t layer1_count = 0;         ///< Particles [0, layer1_count) are layer 1.
+    std::uint32_t line_bands = 1;           ///< Bands of neighbouring lines the particles are stored by (see `grid`).
 
     std::vector<std::uint32_t> grid;        ///< Particle index of (line, row): grid[line * m + row].
     std::vector<std::uint8_t> layer;        ///< 1 or 2 per particle.

@@ -285,34 +285,33 @@ struct PointBounds {
     [[nodiscard]] Real gap(const ListEllipsoid& f) const { return (f.low - high).cwiseMax(low - f.high).maxCoeff(); }
 };
 
-// Bounds of the whole point set, and of each block of `candidate_block` points.
+// Bounds of points [first, end) of x, and of each block of `candidate_block` points from first.
 struct BlockBounds {
     PointBounds all;
     std::vector<PointBounds> blocks;
-    explicit BlockBounds(const Matrix3XRows& x) {
-        const Eigen::Index n = x.cols();
-        blocks.reserve(static_cast<std::size_t>((n + candidate_block - 1) / candidate_block));
-        for (Eigen::Index begin = 0; begin < n; begin += candidate_block) {
-            blocks.emplace_back(x, begin, std::min<Eigen::Index>(candidate_block, n - begin));
+    BlockBounds(const Matrix3XRows& x, Eigen::Index first, Eigen::Index end) {
+        blocks.reserve(static_cast<std::size_t>((end - first + candidate_block - 1) / candidate_block));
+        for (Eigen::Index begin = first; begin < end; begin += candidate_block) {
+            blocks.emplace_back(x, begin, std::min<Eigen::Index>(candidate_block, end - begin));
             all.add(blocks.back());
         }
     }
 };
 
-// Refreshes bit e of the lists of points x (any frame; `f` and `bounds` in the same frame):
-// set where a point is within `margin` of the ellipsoid, cleared elsewhere, and stores in
-// `clearance` (one per point) each unlisted point's clearance from the ellipsoid, +inf for
-// the listed ones. Returns the tests done.
-std::uint64_t refresh_bit(const Matrix3XRows& x, const BlockBounds& bounds, const ListEllipsoid& f, std::size_t e,
-                          Real margin, std::vector<std::uint64_t>& candidates, Real* clearance) {
-    const Eigen::Index n = x.cols();
+// Refreshes bit e of the lists of points [first, end) of x (any frame; `f` and `bounds`, of
+// the same points, in the same frame): set where a point is within `margin` of the
+// ellipsoid, cleared elsewhere, and stores in `clearance` (one per point of x) each unlisted
+// point's clearance from the ellipsoid, +inf for the listed ones. Returns the tests done.
+std::uint64_t refresh_bit(const Matrix3XRows& x, Eigen::Index first, Eigen::Index n, const BlockBounds& bounds,
+                          const ListEllipsoid& f, std::size_t e, Real margin, std::vector<std::uint64_t>& candidates,
+                          Real* clearance) {
     const std::uint64_t bit = std::uint64_t(1) << e;
     std::uint64_t* out = candidates.data();
     constexpr Real listed = std::numeric_limits<Real>::infinity();
-    // Broad phase, whole garment then blocks: a gap between the boxes bounds every distance.
+    // Broad phase, all the points then blocks: a gap between the boxes bounds every distance.
     if (const Real gap = bounds.all.gap(f); gap > margin) {
-        for (Eigen::Index i = 0; i < n; ++i) out[i] &= ~bit;
-        std::fill(clearance, clearance + n, gap - clearance_rounding_m);
+        for (Eigen::Index i = first; i < n; ++i) out[i] &= ~bit;
+        std::fill(clearance + first, clearance + n, gap - clearance_rounding_m);
         return 0;
     }
     const Real* x0 = x.row(0).data();
@@ -321,9 +320,9 @@ std::uint64_t refresh_bit(const Matrix3XRows& x, const BlockBounds& bounds, cons
     const Mat3& m = f.to_unit;
     const Real r0 = f.radii[0], r1 = f.radii[1], r2 = f.radii[2], r_min = f.radii.minCoeff();
     std::uint64_t tests = 0;
-    for (Eigen::Index begin = 0; begin < n; begin += candidate_block) {
+    for (Eigen::Index begin = first; begin < n; begin += candidate_block) {
         const Eigen::Index end = std::min<Eigen::Index>(begin + candidate_block, n);
-        if (const Real gap = bounds.blocks[static_cast<std::size_t>(begin / candidate_block)].gap(f); gap > margin) {
+        if (const Real gap = bounds.blocks[static_cast<std::size_t>((begin - first) / candidate_block)].gap(f); gap > margin) {
             for (Eigen::Index i = begin; i < end; ++i) out[i] &= ~bit;
             std::fill(clearance + begin, clearance + end, gap - clearance_rounding_m);
             continue;
@@ -462,7 +461,8 @@ std::uint64_t refresh_candidate_bit(const Matrix3X& x, std::span<const Ellipsoid
     }
     const Matrix3XRows rows = x;
     VectorX clearance(x.cols());
-    return refresh_bit(rows, BlockBounds(rows), ListEllipsoid(frames[e]), e, margin, candidates, clearance.data());
+    return refresh_bit(rows, 0, rows.cols(), BlockBounds(rows, 0, rows.cols()), ListEllipsoid(frames[e]), e, margin,
+                       candidates, clearance.data());
 }
 
 std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const EllipsoidFrame> frames, Real margin,
@@ -650,9 +650,32 @@ bool has_reference(const Affine3& t) { return t.linear().squaredNorm() > 0; }
 
 }  // namespace
 
-void update_candidate_lists(Garment& g, GarmentSolver& solver) {
+void prepare_candidate_lists(Garment& g, GarmentSolver& solver) {
     CandidateLists& lists = solver.lists;
     const Eigen::Index n = g.state.x.cols();
+    const std::size_t e_count = std::min<std::size_t>(solver.frames.size(), 64);
+    const std::size_t parts = solver.parts.particles.size();
+    const bool valid = lists.valid && lists.parts.size() == parts && lists.reference_x.cols() == n &&
+                       lists.clearance_m.rows() == n && lists.clearance_m.cols() == static_cast<Eigen::Index>(e_count) &&
+                       lists.bits.size() == static_cast<std::size_t>(n) &&
+                       std::all_of(lists.parts.begin(), lists.parts.end(),
+                                   [&](const CandidateListPart& p) { return p.reference_frames.size() == e_count; });
+    lists.scratch.resize(3, n);
+    lists.slack_m.resize(n);
+    if (valid) return;
+    // Everything from scratch: every particle and every ellipsoid is its own reference.
+    lists.parts.assign(parts, CandidateListPart{});
+    lists.bits.assign(static_cast<std::size_t>(n), 0);
+    lists.reference_x.resize(3, n);
+    lists.clearance_m.setConstant(n, static_cast<Eigen::Index>(e_count), std::numeric_limits<Real>::infinity());
+    lists.valid = true;
+    ++g.counters.list_rebuilds;
+}
+
+void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t part_index, PartCounters& counters) {
+    CandidateLists& lists = solver.lists;
+    CandidateListPart& part = lists.parts[part_index];
+    const auto [first, n] = solver.parts.particles[part_index];
     const std::size_t e_count = std::min<std::size_t>(solver.frames.size(), 64);
     const Affine3 anchor = anchor_frame(solver.frames, g.body.anchor);
     const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
@@ -663,7 +686,6 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
 
     // 1. Each particle's position and move d_p in the anchor frame (whole arrays).
     Matrix3XRows& local = lists.scratch;
-    local.resize(3, n);
     {
         // One pass with stride-3 loads; the rows of `local` are contiguous.
         const Vec3 t = anchor.translation();
@@ -672,27 +694,21 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
         Real* l1 = local.row(1).data();
         Real* l2 = local.row(2).data();
         const Mat3& r = to_anchor;
-        for (Eigen::Index p = 0; p < n; ++p) {
+        for (Eigen::Index p = first; p < n; ++p) {
             const Real a = x[3 * p] - t[0], b = x[3 * p + 1] - t[1], c = x[3 * p + 2] - t[2];
             l0[p] = r(0, 0) * a + r(0, 1) * b + r(0, 2) * c;
             l1[p] = r(1, 0) * a + r(1, 1) * b + r(1, 2) * c;
             l2[p] = r(2, 0) * a + r(2, 1) * b + r(2, 2) * c;
         }
     }
-    const bool valid = lists.valid && lists.reference_frames.size() == e_count && lists.reference_x.cols() == n &&
-                       clearance.rows() == n && clearance.cols() == static_cast<Eigen::Index>(e_count) &&
-                       lists.bits.size() == static_cast<std::size_t>(n);
-    if (!valid) {  // everything from scratch: every particle and every ellipsoid is its own reference
-        lists.bits.assign(static_cast<std::size_t>(n), 0);
-        lists.reference_x = local;
-        lists.reference_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
-        clearance.setConstant(n, static_cast<Eigen::Index>(e_count), std::numeric_limits<Real>::infinity());
-        ++g.counters.list_rebuilds;
+    const Eigen::Index count = n - first;
+    if (!part.valid) {  // every particle and every ellipsoid is its own reference
+        lists.reference_x.middleCols(first, count) = local.middleCols(first, count);
+        part.reference_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
     }
-    slack.resize(n);
     {
-        const auto d = (local - lists.reference_x).array();
-        slack = (d.row(0).square() + d.row(1).square() + d.row(2).square()).sqrt().transpose();
+        const auto d = (local.middleCols(first, count) - lists.reference_x.middleCols(first, count)).array();
+        slack.segment(first, count) = (d.row(0).square() + d.row(1).square() + d.row(2).square()).sqrt().transpose();
     }
 
     // 2. Ellipsoids: refresh bit e against the particles' reference points when e has moved
@@ -701,11 +717,11 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
     const Real ellipsoid_limit = ellipsoid_refresh_share * margin;
     std::array<Real, 64> moved_since{};
     for (std::size_t e = 0; e < e_count; ++e) {
-        Affine3& then = lists.reference_frames[e];
+        Affine3& then = part.reference_frames[e];
         if (!solver.frames[e].active) {
             if (has_reference(then)) {
-                for (std::uint64_t& c : lists.bits) c &= ~(std::uint64_t(1) << e);
-                clearance.col(static_cast<Eigen::Index>(e)).setConstant(std::numeric_limits<Real>::infinity());
+                for (Eigen::Index p = first; p < n; ++p) lists.bits[static_cast<std::size_t>(p)] &= ~(std::uint64_t(1) << e);
+                clearance.col(static_cast<Eigen::Index>(e)).segment(first, count).setConstant(std::numeric_limits<Real>::infinity());
                 then.matrix().setZero();
             }
             continue;
@@ -717,8 +733,8 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
             moved_since[e] = moved;
             continue;
         }
-        if (!bounds) bounds.emplace(lists.reference_x);
-        tests += refresh_bit(lists.reference_x, *bounds, ListEllipsoid(current), e, margin, lists.bits,
+        if (!bounds) bounds.emplace(lists.reference_x, first, n);
+        tests += refresh_bit(lists.reference_x, first, n, *bounds, ListEllipsoid(current), e, margin, lists.bits,
                              clearance.col(static_cast<Eigen::Index>(e)).data());
         then = now;
     }
@@ -728,22 +744,22 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
     //    columns. A particle without slack becomes its own reference and is tested against
     //    every reference ellipsoid.
     const std::uint64_t active = active_mask(solver.frames);
-    VectorX room = VectorX::Constant(n, std::numeric_limits<Real>::infinity());
+    VectorX room = VectorX::Constant(count, std::numeric_limits<Real>::infinity());
     for_each_bit(active, [&](int e) {
-        const Real* c = clearance.col(e).data();
+        const Real* c = clearance.col(e).data() + first;
         const Real moved = moved_since[static_cast<std::size_t>(e)];
         Real* r = room.data();
-        for (Eigen::Index p = 0; p < n; ++p) r[p] = std::min(r[p], c[p] - moved);
+        for (Eigen::Index p = 0; p < count; ++p) r[p] = std::min(r[p], c[p] - moved);
     });
-    slack = room - slack;
+    slack.segment(first, count) = room - slack.segment(first, count);
     std::optional<ReferenceLanes> references;  // on first use
     alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
     // The particles without slack, gathered without a branch per particle; pinned ones are
     // never tested (method §3.5).
-    std::vector<Eigen::Index>& spent = lists.spent;
-    spent.resize(static_cast<std::size_t>(n));
+    std::vector<Eigen::Index>& spent = part.spent;
+    spent.resize(static_cast<std::size_t>(count));
     std::size_t spent_count = 0;
-    for (Eigen::Index begin = 0; begin < n; begin += 16) {
+    for (Eigen::Index begin = first; begin < n; begin += 16) {
         const Eigen::Index end = std::min<Eigen::Index>(begin + 16, n);
         if (end - begin == 16 && Eigen::Map<const Eigen::Array<Real, 16, 1>>(slack.data() + begin).minCoeff() >= 0) continue;
         for (Eigen::Index p = begin; p < end; ++p) {
@@ -757,7 +773,7 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
             references.emplace(e_count);
             for_each_bit(active, [&](int e) {
                 const std::size_t ei = static_cast<std::size_t>(e);
-                references->set(ei, lists.reference_frames[ei], moved_since[ei]);
+                references->set(ei, part.reference_frames[ei], moved_since[ei]);
             });
         }
         lists.reference_x.col(p) = local.col(p);
@@ -767,28 +783,50 @@ void update_candidate_lists(Garment& g, GarmentSolver& solver) {
         slack[p] = std::max(Real(0), left);
         tests += static_cast<std::uint64_t>(std::popcount(active));
     }
-    lists.valid = true;
-    g.counters.list_rebuild_tests += tests;
-    g.counters.frame_list_rebuild_tests += tests;
+    part.valid = true;
+    counters.list_tests += tests;
+}
+
+void update_candidate_lists(Garment& g, GarmentSolver& solver) {
+    prepare_candidate_lists(g, solver);
+    PartCounters counters;
+    for (std::size_t k = 0; k < solver.lists.parts.size(); ++k) update_candidate_part(g, solver, k, counters);
+    add_part_counters(g, counters);
+}
+
+void add_part_counters(Garment& g, const PartCounters& c) {
+    GarmentCounters& gc = g.counters;
+    gc.list_rebuild_tests += c.list_tests;
+    gc.frame_list_rebuild_tests += c.list_tests;
+    gc.frame_collision_tests += c.collision_tests;
+    gc.collision_tests += c.collision_tests;
+    gc.frame_collisions += c.collisions;
+    gc.collisions += c.collisions;
+    gc.max_penetration_m = std::max(gc.max_penetration_m, c.max_penetration_m);
+}
+
+CollisionResult collide_part(const Garment& g, GarmentSolver& solver, Matrix3X& x, Matrix3X& v, Eigen::Index first,
+                             Eigen::Index end, bool respond_velocity, PartCounters& counters, DetectedPairs* detected) {
+    const std::vector<std::uint64_t>* lists = nullptr;
+    std::span<const Real> slack;
+    if (g.config.collision == CollisionMode::candidate_lists) {
+        lists = &solver.lists.bits;
+        slack = std::span<const Real>(solver.lists.slack_m.data(), static_cast<std::size_t>(solver.lists.slack_m.size()));
+    }
+    const CollisionResult r = collide_particles(x, v, g.state.inv_mass, solver.frames, lists, solver.last_collided, detected,
+                                                g.config.material.friction, slack, first, end, respond_velocity);
+    counters.collision_tests += r.tests;
+    counters.collisions += r.collisions;
+    counters.max_penetration_m = std::max(counters.max_penetration_m, r.max_penetration_m);
+    return r;
 }
 
 CollisionResult collide_range(Garment& g, GarmentSolver& solver, Eigen::Index first, Eigen::Index end, DetectedPairs* detected,
                               bool respond_velocity) {
-    const std::vector<std::uint64_t>* lists = nullptr;
-    std::span<const Real> slack;
-    if (g.config.collision == CollisionMode::candidate_lists) {
-        if (!solver.lists.valid) update_candidate_lists(g, solver);
-        lists = &solver.lists.bits;
-        slack = std::span<const Real>(solver.lists.slack_m.data(), static_cast<std::size_t>(solver.lists.slack_m.size()));
-    }
-    const CollisionResult r = collide_particles(g.state.x, g.state.v, g.state.inv_mass, solver.frames, lists,
-                                                solver.last_collided, detected, g.config.material.friction, slack, first, end,
-                                                respond_velocity);
-    g.counters.frame_collision_tests += r.tests;
-    g.counters.collision_tests += r.tests;
-    g.counters.frame_collisions += r.collisions;
-    g.counters.collisions += r.collisions;
-    g.counters.max_penetration_m = std::max(g.counters.max_penetration_m, r.max_penetration_m);
+    if (g.config.collision == CollisionMode::candidate_lists && !solver.lists.valid) update_candidate_lists(g, solver);
+    PartCounters counters;
+    const CollisionResult r = collide_part(g, solver, g.state.x, g.state.v, first, end, respond_velocity, counters, detected);
+    add_part_counters(g, counters);
     return r;
 }
 

@@ -83,6 +83,16 @@ std::uint64_t build_candidate_lists(const Matrix3X& x, std::span<const Ellipsoid
 /// move before its list could miss an ellipsoid (>= 0).
 void update_candidate_lists(Garment& garment, GarmentSolver& solver);
 
+/// Step 1 in parts (garment_parts.hpp), as update_candidate_lists does it: first, on one
+/// thread, the lists sized for the garment (all rebuilt when they were not valid or a size
+/// changed); then each particle range of solver.parts on its own, at the same time as the
+/// others (each keeps its own collider references), its tests added to `counters`.
+void prepare_candidate_lists(Garment& garment, GarmentSolver& solver);
+void update_candidate_part(const Garment& garment, GarmentSolver& solver, std::size_t part, PartCounters& counters);
+
+/// Adds a part's counts to the garment's counters.
+void add_part_counters(Garment& garment, const PartCounters& counters);
+
 /// What a collision pass did.
 struct CollisionResult {
     std::uint64_t tests = 0;          ///< Unit-sphere tests (detection and re-tests).
@@ -118,6 +128,13 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
 /// garment's counters.
 CollisionResult collide_range(Garment& garment, GarmentSolver& solver, Eigen::Index first, Eigen::Index end,
                               DetectedPairs* detected = nullptr, bool respond_velocity = true);
+
+/// collide_range for positions `x` and velocities `v` of the garment's size, its counts added
+/// to `counters` rather than the garment's (for parts running at the same time; the lists of
+/// particles [first, end) must be up to date).
+CollisionResult collide_part(const Garment& garment, GarmentSolver& solver, Matrix3X& x, Matrix3X& v,
+                             Eigen::Index first, Eigen::Index end, bool respond_velocity, PartCounters& counters,
+                             DetectedPairs* detected = nullptr);
 
 /// Whole garment: update_candidate_lists in list mode, then collide_range over every particle.
 CollisionResult collide_garment(Garment& garment, GarmentSolver& solver, DetectedPairs* detected = nullptr);

@@ -82,7 +82,27 @@ void solve_strip(int count, Real* __restrict a0, Real* __restrict a1, Real* __re
 
 }  // namespace
 
-void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& w, Real h, Real limit) {
+std::vector<std::vector<SpringStrip>> split_strips(const std::vector<SpringStrip>& strips,
+                                                 const std::vector<std::uint32_t>& band, std::size_t bands) {
+    std::vector<std::vector<SpringStrip>> parts(bands);
+    if (bands == 1) {
+        parts[0] = strips;
+        return parts;
+    }
+    for (const SpringStrip& st : strips) {
+        std::uint32_t k = 0;
+        while (k < st.count) {
+            const std::uint32_t b = band[st.a + k * st.stride];
+            std::uint32_t len = 1;
+            while (k + len < st.count && band[st.a + (k + len) * st.stride] == b) ++len;
+            parts[b].push_back({st.a + k * st.stride, st.b + k * st.stride, st.first + k * st.stride, len, st.stride});
+            k += len;
+        }
+    }
+    return parts;
+}
+
+void solve_springs(SpringSet& set, std::size_t part, Matrix3XRows& x, const VectorX& w, Real h, Real limit) {
     Real* x0 = x.row(0).data();
     Real* x1 = x.row(1).data();
     Real* x2 = x.row(2).data();
@@ -92,7 +112,7 @@ void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& w, Real h, Re
     const Real* compliance = set.compliance.data();
     Real* lambda = set.lambda.data();
     const Real* wp = w.data();
-    for (const SpringStrip& st : set.strips) {
+    for (const SpringStrip& st : set.parts[part]) {
         const int count = static_cast<int>(st.count);
         const std::uint32_t a = st.a, b = st.b, f = st.first;
         if (st.stride == 1)
@@ -134,6 +154,17 @@ Tethers build_tethers(const Fabric& f, const VectorX& w, const VectorX& above) {
     return t;
 }
 
+std::vector<Tethers> split_tethers(const Tethers& t, const std::vector<std::uint32_t>& band, std::size_t bands) {
+    std::vector<Tethers> parts(bands);
+    for (std::size_t k = 0; k < t.particle.size(); ++k) {
+        Tethers& part = parts[band[t.particle[k]]];
+        part.particle.push_back(t.particle[k]);
+        part.anchor.push_back(t.anchor[k]);
+        part.length_m.push_back(t.length_m[k]);
+    }
+    return parts;
+}
+
 void solve_tethers(const Tethers& t, Matrix3XRows& x) {
     Real* x0 = x.row(0).data();
     Real* x1 = x.row(1).data();
@@ -151,15 +182,17 @@ void solve_tethers(const Tethers& t, Matrix3XRows& x) {
     }
 }
 
-void limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real stretch, Matrix3X& x,
-                      Matrix3X& moves) {
-    moves.setZero();
-    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+std::uint64_t limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real stretch, Matrix3X& x,
+                               Matrix3X& moves, std::uint32_t first_line, std::uint32_t end_line) {
+    std::uint64_t moved = 0;
+    const std::uint32_t m = f.particles_per_line;
+    for (std::uint32_t line = first_line; line < end_line; ++line)
+        for (std::uint32_t row = 0; row < m; ++row) moves.col(f.grid[line * m + row]).setZero();
     const Real scale = 1 + stretch;
     // Row after row from the fitting zone down, every line of the row in turn: the particle
     // above has its final place when its neighbour below is limited.
     for (std::uint32_t row = 1; row < m; ++row)
-        for (std::uint32_t line = 0; line < n; ++line) {
+        for (std::uint32_t line = first_line; line < end_line; ++line) {
             const std::uint32_t p = f.grid[line * m + row], q = f.grid[line * m + row - 1];
             if (w[p] == 0) continue;
             const Vec3 d = x.col(p) - x.col(q);
@@ -168,7 +201,9 @@ void limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX&
             const Vec3 move = d * (longest / std::sqrt(length_sq) - 1);
             x.col(p) += move;
             moves.col(p) = move;
+            ++moved;
         }
+    return moved;
 }
 
 }  // namespace drape

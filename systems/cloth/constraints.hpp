@@ -40,10 +40,18 @@ struct SpringStrip {
 /// then its odd ones; springs that fit no run become strips of one.
 [[nodiscard]] std::vector<SpringStrip> spring_strips(const SpringPhase& springs);
 
+/// The strips cut where `band` (per particle) changes along a strip: part k's strips, in
+/// solving order, hold the springs whose `a` end is in band k (both ends must be in the
+/// same band). One band gives the strips as they are.
+[[nodiscard]] std::vector<std::vector<SpringStrip>> split_strips(const std::vector<SpringStrip>& strips,
+                                                                 const std::vector<std::uint32_t>& band,
+                                                                 std::size_t bands);
+
 /// Springs of one phase as the solver sees them.
 struct SpringSet {
     const SpringPhase* springs = nullptr;
-    std::vector<SpringStrip> strips;
+    std::vector<std::vector<SpringStrip>> parts;  ///< Per band of the garment's parts (garment_parts.hpp): its strips.
+    bool by_lines = false;         ///< Cut by line bands (warp) rather than row bands.
     std::vector<Real> compliance;  ///< Per spring: 1 / k, m/N (1e30: a spring without force).
     std::vector<Real> lambda;      ///< Per spring: XPBD multiplier of the current substep.
     bool limited = true;           ///< Provot's limit applies (structural springs).
@@ -53,9 +61,9 @@ struct SpringSet {
 /// `area` per particle; a modulus of 0 gives a spring without force (limit only).
 [[nodiscard]] std::vector<Real> spring_compliance(const SpringPhase& springs, const VectorX& area, Real modulus_N_m);
 
-/// One Gauss-Seidel round over `set` (step 2) in a substep of h_s, strip by strip, on positions
-/// held one row per coordinate. `inv_mass` 0 = does not move.
-void solve_springs(SpringSet& set, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
+/// One Gauss-Seidel round over part `part` of `set` (step 1) in a substep of h_s, strip by
+/// strip, on positions held one row per coordinate. `inv_mass` 0 = does not move.
+void solve_springs(SpringSet& set, std::size_t part, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
 
 /// Long-range attachments (step 2): one per free particle below a pinned one on its line.
 struct Tethers {
@@ -73,6 +81,10 @@ struct Tethers {
 /// warp_rest_above(fabric).
 [[nodiscard]] Tethers build_tethers(const Fabric& fabric, const VectorX& inv_mass, const VectorX& rest_above);
 
+/// The tethers of each band: those whose particle is in band k (order kept).
+[[nodiscard]] std::vector<Tethers> split_tethers(const Tethers& tethers, const std::vector<std::uint32_t>& band,
+                                                 std::size_t bands);
+
 /// One pass over the tethers (step 2).
 void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 
@@ -80,8 +92,10 @@ void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 /// row from the fitting zone down, a free particle farther than (1 + stretch) x rest from
 /// the particle above it on its line is moved back onto that sphere, the particle above
 /// staying where it is (it already has its final place), so no warp spring is longer than
-/// that afterwards. `moves` receives each particle's move (zero for the rest).
-void limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real stretch,
-                      Matrix3X& x, Matrix3X& moves);
+/// that afterwards. `moves` receives each particle's move (zero for the rest). Lines
+/// [first_line, end_line) only; the lines are independent of each other. Returns the
+/// particles moved.
+std::uint64_t limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real stretch,
+                      Matrix3X& x, Matrix3X& moves, std::uint32_t first_line, std::uint32_t end_line);
 
 }  // namespace drape

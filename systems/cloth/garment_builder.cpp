@@ -18,6 +18,7 @@
 #include "systems/cloth/body.hpp"
 #include "systems/cloth/collision.hpp"
 #include "systems/cloth/garment_parameters.hpp"
+#include "systems/cloth/garment_parts.hpp"
 #include "systems/cloth/garment_step.hpp"
 #include "systems/cloth/pins.hpp"
 
@@ -400,20 +401,25 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
     const auto gi = [&](std::uint32_t line, std::uint32_t row) { return line * m + row; };
 
     // Particle order: layer 1 first (one contiguous block to integrate), then layer 2 by the
-    // lines' place between their layer-1 neighbours (line % stride); within each block row
-    // by row, the block's lines side by side. A row of warp springs of one block, or of weft
-    // springs between two blocks, then joins consecutive particles to consecutive particles:
-    // the solver takes each such row as one strip of independent springs, rows from the
-    // fitting zone down (constraints.hpp).
+    // lines' place between their layer-1 neighbours (line % stride); within each block band
+    // by band of neighbouring lines (garment_parts.hpp; one band below 10,000 particles),
+    // within a band row by row, its lines side by side. A row of warp springs of one band,
+    // or of weft springs between two blocks, then joins consecutive particles to consecutive
+    // particles: the solver takes each such row as one strip of independent springs, rows
+    // from the fitting zone down (constraints.hpp).
     t->grid.assign(n * m, 0);
     t->layer.assign(n * m, 0);
+    t->line_bands = part_count(n, m);
+    const std::vector<std::uint32_t> edges = line_band_edges(n, stride, t->line_bands);
     std::uint32_t next = 0;
     for (std::uint32_t offset = 0; offset < stride; ++offset)
-        for (std::uint32_t row = 0; row < m; ++row)
-            for (std::uint32_t line = offset; line < n; line += stride) {
-                t->grid[gi(line, row)] = next;
-                t->layer[next++] = static_cast<std::uint8_t>(offset == 0 ? 1 : 2);
-            }
+        for (std::uint32_t band = 0; band < t->line_bands; ++band)
+            for (std::uint32_t row = 0; row < m; ++row)
+                for (std::uint32_t line = offset; line < n; line += stride) {
+                    if (line_band_of(edges, line) != band) continue;
+                    t->grid[gi(line, row)] = next;
+                    t->layer[next++] = static_cast<std::uint8_t>(offset == 0 ? 1 : 2);
+                }
     t->layer1_count = static_cast<std::uint32_t>(std::count(t->layer.begin(), t->layer.end(), 1));
 
     const auto at = [&](std::uint32_t line, std::uint32_t row) { return t->grid[gi(line, row)]; };

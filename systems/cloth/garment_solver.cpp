@@ -40,10 +40,12 @@ void derive_masses(const Garment& g, GarmentSolver& s) {
     s.drag_N_s_m = drag;
 }
 
-SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus, bool limited) {
+SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus, bool limited, const GarmentParts& parts,
+                     bool by_lines) {
     SpringSet set;
     set.springs = &phase;
-    set.strips = spring_strips(phase);
+    set.parts = split_strips(spring_strips(phase), by_lines ? parts.line_band : parts.row_band, parts.count);
+    set.by_lines = by_lines;
     set.compliance = spring_compliance(phase, area, modulus);
     set.lambda.assign(phase.size(), 0);
     set.limited = limited;
@@ -71,23 +73,32 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
                 area[t.weft_left[k]] += (1 - share) * t.area_m2[t.weft_particle[k]];
                 area[t.weft_right[k]] += share * t.area_m2[t.weft_particle[k]];
             }
+        s.parts = make_parts(t, g.config.model, s.integrated);
+        const GarmentParts& parts = s.parts;
         s.springs.clear();
         if (simplified) {
-            // Weft springs, then the warp: layer 1's (with the areas its particles stand for),
-            // then layer 2's.
-            s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true));
-            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
-            s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true));
+            // Weft springs (row bands), then the warp (line bands): layer 1's (with the areas
+            // its particles stand for), then layer 2's.
+            s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true, parts, false));
+            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts, true));
+            s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true, parts, true));
         } else {
             // Shear and bend first: the structural springs and their limit have the last word.
-            s.springs.push_back(spring_set(t.shear, area, m.shear_N_m, false));
-            s.springs.push_back(spring_set(t.bend, area, m.bend_N_m, false));
-            s.springs.push_back(spring_set(t.weft, area, m.stretch_N_m, true));
-            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true));
-            s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true));
+            // One part (garment_parts.hpp): every set in the row stage, in this order.
+            s.springs.push_back(spring_set(t.shear, area, m.shear_N_m, false, parts, false));
+            s.springs.push_back(spring_set(t.bend, area, m.bend_N_m, false, parts, false));
+            s.springs.push_back(spring_set(t.weft, area, m.stretch_N_m, true, parts, false));
+            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts, false));
+            s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true, parts, false));
         }
         s.warp_rest_above = warp_rest_above(t);
-        s.tethers = build_tethers(t, state.inv_mass, s.warp_rest_above);
+        s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.line_band, parts.count);
+        s.below.resize(static_cast<std::size_t>(n));
+        const std::uint32_t rows = t.particles_per_line;
+        for (std::uint32_t line = 0; line < t.warp_lines; ++line)
+            for (std::uint32_t row = 0; row < rows; ++row)
+                s.below[t.grid[line * rows + row]] = t.grid[line * rows + std::min(row + 1, rows - 1)];
+        s.part_counters.assign(parts.count, PartCounters{});
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;
         s.built_fabric = &t;
@@ -96,6 +107,9 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
     }
     if (s.warp_moves.cols() != n) s.warp_moves = Matrix3X::Zero(3, n);
     if (s.x_round.cols() != n) s.x_round = Matrix3X::Zero(3, n);
+    if (s.x_start.cols() != n) s.x_start = Matrix3X::Zero(3, n);
+    if (s.push.cols() != n) s.push = Matrix3X::Zero(3, n);
+    if (s.x_rows.cols() != n) s.x_rows = Matrix3XRows::Zero(3, n);
     if (s.last_collided.size() != static_cast<std::size_t>(n)) s.last_collided.assign(static_cast<std::size_t>(n), 0);
     if (s.contacts.size() != static_cast<std::size_t>(n)) s.contacts.assign(static_cast<std::size_t>(n), 0);
 }

@@ -15,6 +15,7 @@
 #include "components/garment.hpp"
 #include "engine/core/math.hpp"
 #include "systems/cloth/constraints.hpp"
+#include "systems/cloth/garment_parts.hpp"
 
 namespace drape {
 
@@ -30,16 +31,31 @@ struct EllipsoidFrame {
     bool active = false;               ///< False when the collider entity is gone: never tested.
 };
 
+/// The candidate lists of one particle range (garment_parts.hpp): each range keeps its own
+/// collider references, so that ranges are brought up to date independently.
+struct CandidateListPart {
+    bool valid = false;                      ///< False: rebuild before the next test.
+    std::vector<Affine3> reference_frames;   ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed in this range (zero: none).
+    std::vector<Eigen::Index> spent;         ///< Scratch: the particles whose list is refreshed.
+};
+
 /// Candidate lists with their references (method §5, spatial locality; collision.hpp step 1).
 struct CandidateLists {
     std::vector<std::uint64_t> bits;         ///< Per particle: bit e set = ellipsoid e is in its pre-collision list.
-    bool valid = false;                      ///< False: rebuild before the next test.
+    bool valid = false;                      ///< False: rebuild every range before the next test.
     Matrix3XRows reference_x;                ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
-    std::vector<Affine3> reference_frames;   ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed (zero: none).
+    std::vector<CandidateListPart> parts;    ///< Per particle range of GarmentSolver::parts.
     Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
     VectorX slack_m;                         ///< Per particle: how far it may still move before its list could miss a collider, after the last update, m.
     Matrix3XRows scratch;                    ///< Anchor-frame positions, reused every substep.
-    std::vector<Eigen::Index> spent;         ///< Scratch: the particles whose list is refreshed.
+};
+
+/// What one part's collision did in a stage, added to the garment's counters afterwards.
+struct PartCounters {
+    std::uint64_t collision_tests = 0, collisions = 0, list_tests = 0, list_rebuilds = 0;
+    Real max_penetration_m = 0;
+    std::uint64_t warp_moved = 0;  ///< Particles the warp limit moved.
+    bool finite = true;
 };
 
 struct GarmentSolver {
@@ -53,8 +69,10 @@ struct GarmentSolver {
     VectorX inv_mass;                        ///< Of every particle as the solver moves it: a layer-1 particle of the
                                              ///< simplified model carries the mass of the weft particles it carries.
     VectorX drag_N_s_m;                      ///< eq. 2's k per particle, with the same shares.
+    GarmentParts parts;                      ///< The garment's work in fixed parts (garment_parts.hpp).
     std::vector<SpringSet> springs;          ///< The springs the model solves, in order.
-    Tethers tethers;                         ///< Long-range attachments from the pins.
+    std::vector<Tethers> tethers;            ///< Long-range attachments from the pins, per line band.
+    std::vector<std::uint32_t> below;        ///< Per particle: the particle below it on its line (itself in the last row).
     VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
                                              ///< on its line (0 in the first row).
     Real drag_step_s = 0;                    ///< Largest stable step of the explicit drag.
@@ -76,7 +94,7 @@ struct GarmentSolver {
     Matrix3X push;                           ///< Per particle: the collision rounds' push-outs this substep.
     std::vector<std::uint64_t> contacts;     ///< Per particle: ellipsoids it touched in this substep's rounds.
     Matrix3X warp_moves;                     ///< Per particle: the warp limit's move this substep.
-    std::vector<std::uint64_t> block_collided; ///< Scratch: last_collided of one block of particles.
+    std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.
 };
 
 /// Sizes the scratch arrays and masks for `garment` and drops the caches that depend on a

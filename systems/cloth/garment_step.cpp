@@ -2,6 +2,7 @@
 #include "systems/cloth/garment_step.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -70,16 +71,24 @@ AnchorMotion anchor_motion(const Registry& registry, const Garment& g, GarmentSo
 void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
     GarmentState& state = g.state;
-    s.x_start = state.x;  // no allocation once sized
-    s.push.setZero(3, state.x.cols());
-    std::fill(s.contacts.begin(), s.contacts.end(), 0);
     for (SpringSet& set : s.springs) std::fill(set.lambda.begin(), set.lambda.end(), Real(0));
     const AnchorMotion motion = anchor_motion(registry, g, s, sub);
     const Vec3 gravity(0, -standard_gravity_m_s2, 0);
-    predict_particles(state.x, state.v, s.inv_mass, s.drag_N_s_m, s.integrated, motion, g.config.inertia, gravity,
-                      static_cast<Real>(sub.h_s));
-    // §4.2: layer 2 is carried by the layer 1 it hangs between (weft.hpp).
-    if (g.config.model == ClothModel::simplified) carry_weft(*g.fabric, state.inv_mass, s.x_start, state.x);
+    const Real h = static_cast<Real>(sub.h_s);
+    const bool carry = g.config.model == ClothModel::simplified;
+    // Row bands (garment_parts.hpp): a layer-2 particle's chord ends are in its row.
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        for (const ParticleRun& r : s.parts.row_runs[k]) {
+            const Eigen::Index count = r.end - r.begin;
+            s.x_start.middleCols(r.begin, count) = state.x.middleCols(r.begin, count);
+            s.push.middleCols(r.begin, count).setZero();
+            std::fill(s.contacts.begin() + r.begin, s.contacts.begin() + r.end, 0);
+        }
+        for (const ParticleRun& r : s.parts.integrated_runs[k])
+            predict_particles(state.x, state.v, s.inv_mass, s.drag_N_s_m, r.begin, r.end, motion, g.config.inertia, gravity, h);
+        // §4.2: layer 2 is carried by the layer 1 it hangs between (weft.hpp).
+        if (carry) carry_weft(*g.fabric, s.parts.weft_entries[k], state.inv_mass, s.x_start, state.x);
+    });
     s.anchor_velocity_before = motion.velocity_m_s;
     s.anchor_angular_before = motion.angular_velocity_rad_s;
     s.anchor_known = true;
@@ -100,28 +109,52 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
     Matrix3X& x = g.state.x;
     const Real h = static_cast<Real>(sub.h_s);
     const Real limit = g.config.material.strain_limit;
-    s.x_rows = x;  // one row per coordinate: the strips run in vector lanes
-    for (SpringSet& set : s.springs) solve_springs(set, s.x_rows, s.inv_mass, h, limit);
-    if (round + 1 == constraint_rounds(g)) solve_tethers(s.tethers, s.x_rows);
-    x = s.x_rows;
+    const bool tethers = round + 1 == constraint_rounds(g);
+    // Row bands: positions in, one row per coordinate (the strips run in vector lanes), then
+    // the sets cut by rows (the weft; every set of the classic model, in one part).
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        for (const ParticleRun& r : s.parts.row_runs[k])
+            s.x_rows.middleCols(r.begin, r.end - r.begin) = x.middleCols(r.begin, r.end - r.begin);
+        for (SpringSet& set : s.springs)
+            if (!set.by_lines) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
+    });
+    // Line bands: the warp sets, in the last round the tethers, then positions out.
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        for (SpringSet& set : s.springs)
+            if (set.by_lines) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
+        if (tethers) solve_tethers(s.tethers[k], s.x_rows);
+        for (const ParticleRun& r : s.parts.line_runs[k])
+            x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);
+    });
 }
 
 void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSubstep&, int) {
     prepare_solver(g, s);
     // The constraints moved the particles since the last round: the lists are brought up to
     // date for where they are now (only what moved far enough is refreshed, collision.hpp).
-    if (g.config.collision == CollisionMode::candidate_lists) update_candidate_lists(g, s);
+    const bool lists = g.config.collision == CollisionMode::candidate_lists;
+    if (lists) prepare_candidate_lists(g, s);
     Matrix3X& x = g.state.x;
-    s.x_round = x;
-    collide_range(g, s, 0, x.cols(), nullptr, /*respond_velocity=*/false);
-    for (std::size_t p = 0; p < s.contacts.size(); ++p) s.contacts[p] |= s.last_collided[p];
-    s.push += x - s.x_round;
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        PartCounters& c = s.part_counters[k] = PartCounters{};
+        const auto [first, end] = s.parts.particles[k];
+        if (lists) update_candidate_part(g, s, k, c);
+        s.x_round.middleCols(first, end - first) = x.middleCols(first, end - first);
+        collide_part(g, s, x, g.state.v, first, end, /*respond_velocity=*/false, c);
+        for (Eigen::Index p = first; p < end; ++p) s.contacts[static_cast<std::size_t>(p)] |= s.last_collided[static_cast<std::size_t>(p)];
+        s.push.middleCols(first, end - first) += x.middleCols(first, end - first) - s.x_round.middleCols(first, end - first);
+    });
+    for (const PartCounters& c : s.part_counters) add_part_counters(g, c);
 }
 
 void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep&) {
     prepare_solver(g, s);
-    limit_warp_lines(*g.fabric, s.warp_rest_above, s.inv_mass, warp_limit_share * g.config.material.strain_limit,
-                     g.state.x, s.warp_moves);
+    const Real stretch = warp_limit_share * g.config.material.strain_limit;
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        const auto [first_line, end_line] = s.parts.lines[k];
+        s.part_counters[k].warp_moved =
+            limit_warp_lines(*g.fabric, s.warp_rest_above, s.inv_mass, stretch, g.state.x, s.warp_moves, first_line, end_line);
+    });
 }
 
 std::uint64_t count_non_finite(const Garment& g) {
@@ -130,8 +163,9 @@ std::uint64_t count_non_finite(const Garment& g) {
 
 namespace {
 
-// The velocity after the substep of every free particle, layer 2 too: its move over the
-// substep, as Provot's velocities follow his corrections, with two parts that are not motion:
+// The velocity after the substep of the free particles [first, end), layer 2 too: its move
+// over the substep, as Provot's velocities follow his corrections, with two parts that are
+// not motion:
 // - the warp limit's move of the particle below it on its line (follow the leader with the
 //   damping of dynamic follow-the-leader: the leader feels most of what it did to the
 //   follower, which a one-sided move would otherwise add as energy);
@@ -139,68 +173,65 @@ namespace {
 //   velocity it had without them where that leaves the surface, else the surface's (no
 //   approach, method §5); along it, the motion relative to the surface slowed by Coulomb
 //   friction (shortened by `friction` x the approach removed, never reversed).
-void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
-    const Fabric& t = *g.fabric;
+void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Eigen::Index first, Eigen::Index end) {
     Matrix3X& x = g.state.x;
     Matrix3X& v = g.state.v;
     const Real inv_h = static_cast<Real>(1 / sub.h_s);
     const Real friction = g.config.material.friction;
-    const std::uint32_t m = t.particles_per_line;
-    for (std::uint32_t line = 0; line < t.warp_lines; ++line)
-        for (std::uint32_t row = 0; row < m; ++row) {
-            const std::uint32_t p = t.grid[line * m + row];
-            if (s.inv_mass[p] == 0) continue;  // pins: their velocity is the skin's
-            Vec3 moved = (x.col(p) - s.x_start.col(p)) * inv_h;
-            if (row + 1 < m) moved -= leader_damping * inv_h * s.warp_moves.col(t.grid[line * m + row + 1]);
-            const std::uint64_t touched = s.contacts[p];
-            if (touched == 0) {
-                v.col(p) = moved;
-                continue;
-            }
-            const Vec3 unpushed = moved - s.push.col(p) * inv_h;
-            Vec3 vp = moved;
-            for (std::uint64_t bits = touched; bits != 0; bits &= bits - 1) {
-                const EllipsoidFrame& f = s.frames[static_cast<std::size_t>(std::countr_zero(bits))];
-                if (!f.active) continue;
-                const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, x.col(p))).normalized();
-                if (!normal.allFinite()) continue;
-                const Vec3 surface = body_velocity_at(f, x.col(p));
-                const Real away = (unpushed - surface).dot(normal);
-                Vec3 tangential = (vp - surface) - (vp - surface).dot(normal) * normal;
-                if (away < 0) {
-                    const Real t_len = tangential.norm();
-                    if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
-                }
-                vp = surface + tangential + std::max(away, Real(0)) * normal;
-            }
-            v.col(p) = vp;
+    for (Eigen::Index p = first; p < end; ++p) {
+        if (s.inv_mass[p] == 0) continue;  // pins: their velocity is the skin's
+        Vec3 moved = (x.col(p) - s.x_start.col(p)) * inv_h;
+        const std::uint32_t below = s.below[static_cast<std::size_t>(p)];
+        if (below != static_cast<std::uint32_t>(p)) moved -= leader_damping * inv_h * s.warp_moves.col(below);
+        const std::uint64_t touched = s.contacts[static_cast<std::size_t>(p)];
+        if (touched == 0) {
+            v.col(p) = moved;
+            continue;
         }
+        const Vec3 unpushed = moved - s.push.col(p) * inv_h;
+        Vec3 vp = moved;
+        for (std::uint64_t bits = touched; bits != 0; bits &= bits - 1) {
+            const EllipsoidFrame& f = s.frames[static_cast<std::size_t>(std::countr_zero(bits))];
+            if (!f.active) continue;
+            const Vec3 normal = (f.to_unit.transpose() * to_unit_sphere(f, x.col(p))).normalized();
+            if (!normal.allFinite()) continue;
+            const Vec3 surface = body_velocity_at(f, x.col(p));
+            const Real away = (unpushed - surface).dot(normal);
+            Vec3 tangential = (vp - surface) - (vp - surface).dot(normal) * normal;
+            if (away < 0) {
+                const Real t_len = tangential.norm();
+                if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
+            }
+            vp = surface + tangential + std::max(away, Real(0)) * normal;
+        }
+        v.col(p) = vp;
+    }
 }
 
 // The warp limit moved particles after the last collision round (on the sample scene's walk
-// 153 of 837 per substep, 61 of them by a millimetre or more): each block of 64 particles
-// holding one is collided again, in
-// the garment's collision mode (the lists brought up to date first), positions only; the
-// last round's contacts are kept.
-void collide_warp_moves(Garment& g, GarmentSolver& s) {
-    const Eigen::Index n = g.state.x.cols();
+// 153 of 837 per substep, 61 of them by a millimetre or more): in particle range `part`,
+// each block of 64 particles holding one is collided again, in the garment's collision mode
+// (the range's lists brought up to date first), positions only; the last round's contacts
+// are kept.
+void collide_warp_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCounters& c) {
     constexpr Eigen::Index block = 64;
+    const auto [first, n] = s.parts.particles[part];
     bool lists_current = false;
-    for (Eigen::Index begin = 0; begin < n; begin += block) {
+    std::array<std::uint64_t, block> before{};
+    for (Eigen::Index begin = first; begin < n; begin += block) {
         const Eigen::Index end = std::min(begin + block, n);
         if (s.warp_moves.middleCols(begin, end - begin).cwiseAbs().maxCoeff() == 0) continue;
         if (!lists_current && g.config.collision == CollisionMode::candidate_lists) {
-            update_candidate_lists(g, s);
+            update_candidate_part(g, s, part, c);
             lists_current = true;
         }
         s.x_round.middleCols(begin, end - begin) = g.state.x.middleCols(begin, end - begin);
-        const auto first = s.last_collided.begin() + begin, last = s.last_collided.begin() + end;
-        s.block_collided.assign(first, last);
-        collide_range(g, s, begin, end, nullptr, /*respond_velocity=*/false);
+        std::copy(s.last_collided.begin() + begin, s.last_collided.begin() + end, before.begin());
+        collide_part(g, s, g.state.x, g.state.v, begin, end, /*respond_velocity=*/false, c);
         for (Eigen::Index p = begin; p < end; ++p) {
             const std::size_t i = static_cast<std::size_t>(p);
             s.contacts[i] |= s.last_collided[i];
-            s.last_collided[i] |= s.block_collided[i - static_cast<std::size_t>(begin)];  // last round's contacts stay
+            s.last_collided[i] |= before[static_cast<std::size_t>(p - begin)];  // last round's contacts stay
         }
         s.push.middleCols(begin, end - begin) += g.state.x.middleCols(begin, end - begin) - s.x_round.middleCols(begin, end - begin);
     }
@@ -208,16 +239,32 @@ void collide_warp_moves(Garment& g, GarmentSolver& s) {
 
 // Every value finite, in one vectorised pass: x * 0 is 0 for a finite x and NaN for an
 // infinity or a NaN, and the sum carries the NaN (Eigen's allFinite() tests value by value).
-bool all_finite(const Matrix3X& m) { return !std::isnan((m.array() * 0).sum()); }
+template <class M>
+bool all_finite(const M& m) {
+    return !std::isnan((m.array() * 0).sum());
+}
 
 }  // namespace
 
 void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
-    collide_warp_moves(g, s);
-    update_velocities(g, s, sub);
+    // The lists are sized on this thread first when the warp limit moved anything.
+    const bool moved = std::any_of(s.part_counters.begin(), s.part_counters.end(), [](const PartCounters& c) { return c.warp_moved > 0; });
+    if (moved && g.config.collision == CollisionMode::candidate_lists) prepare_candidate_lists(g, s);
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        PartCounters& c = s.part_counters[k] = PartCounters{};
+        const auto [first, end] = s.parts.particles[k];
+        if (moved) collide_warp_moves(g, s, k, c);
+        update_velocities(g, s, sub, first, end);
+        c.finite = all_finite(g.state.x.middleCols(first, end - first)) && all_finite(g.state.v.middleCols(first, end - first));
+    });
+    bool finite = true;
+    for (const PartCounters& c : s.part_counters) {
+        add_part_counters(g, c);
+        finite = finite && c.finite;
+    }
     // A NaN or infinity must not spread: report it once, count it, and start again from rest.
-    if (!all_finite(g.state.x) || !all_finite(g.state.v)) {
+    if (!finite) {
         const std::uint64_t bad = count_non_finite(g);
         g.counters.non_finite_values += bad;
         std::fprintf(stderr, "drape: cloth: %llu non-finite particle values after step %llu; garment reset to rest\n",

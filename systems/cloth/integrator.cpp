@@ -7,13 +7,14 @@
 namespace drape {
 
 void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const VectorX& drag,
-                       Eigen::Index count, const AnchorMotion& f, const InertiaScales& inertia, const Vec3& g, Real h) {
+                       Eigen::Index first, Eigen::Index end, const AnchorMotion& f, const InertiaScales& inertia,
+                       const Vec3& g, Real h) {
     if (inertia.linear == 1 && inertia.angular == 1) {
         // The particles feel all of the frame's motion: its inertial and fictitious forces
         // cancel the frame's own motion, and the motion in the frame is the motion in the
         // world. Integrated there directly: the same scheme without the frame changes.
         const Vec3 drag_body_offset = f.acceleration_m_s2 * (h / 2);  // eq. 2: v_b + a_b h / 2
-        for (Eigen::Index i = 0; i < count; ++i) {
+        for (Eigen::Index i = first; i < end; ++i) {
             const Real inv_m = inv_mass[i];
             if (inv_m == 0) continue;  // pinned: follows the skin (method §3.5)
             const Vec3 vi = v.col(i);
@@ -31,7 +32,7 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
     const Vec3 angular_kick = inertia.angular * (w - w_before);
     const Vec3 drag_body_offset = f.acceleration_m_s2 * (h / 2);  // eq. 2: v_b + a_b h / 2
     const Real s_ang = inertia.angular;
-    for (Eigen::Index i = 0; i < count; ++i) {
+    for (Eigen::Index i = first; i < end; ++i) {
         const Real inv_m = inv_mass[i];
         if (inv_m == 0) continue;  // pinned: follows the skin (method §3.5)
         const Vec3 vi = v.col(i);

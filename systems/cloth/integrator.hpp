@@ -41,9 +41,9 @@ struct AnchorMotion {
     Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b (eq. 2's drag term).
 };
 
-/// Prediction of particles [0, count): `drag` is each particle's k (N s/m).
+/// Prediction of particles [first, end): `drag` is each particle's k (N s/m).
 void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const VectorX& drag_N_s_m,
-                       Eigen::Index count, const AnchorMotion& anchor, const InertiaScales& inertia,
+                       Eigen::Index first, Eigen::Index end, const AnchorMotion& anchor, const InertiaScales& inertia,
                        const Vec3& gravity_m_s2, Real h_s);
 
 /// Largest step for which the explicit drag of eq. 2 stays stable: min over particles of m / k.

@@ -8,6 +8,7 @@
 #include "components/transform.hpp"
 #include "systems/cloth/body.hpp"
 #include "systems/cloth/collision.hpp"
+#include "systems/cloth/garment_parts.hpp"
 
 namespace drape {
 
@@ -57,27 +58,31 @@ void update_pin_targets(const Registry& registry, const Garment& g, GarmentSolve
         for (Eigen::Index i = 0; i < n; ++i) s.pin_target.col(i) = g.state.x.col(pins[static_cast<std::size_t>(i)].particle);
     }
     s.pin_previous = s.pin_target;
-    for (Eigen::Index i = 0; i < n; ++i) {
-        if (auto p = evaluate_pin(registry, g, pins[static_cast<std::size_t>(i)])) s.pin_target.col(i) = *p;
-    }
     // Fitting-zone points sit on or outside the collision body (method §3.5): where an
     // ellipsoid stands out of the skin (a bone-bound ellipsoid does not blend like the skin
     // between two bones; an arm hangs against the chest) the pin leaves it the shortest way.
     update_frames(registry, g.body, s.pin_frames, 1);
-    for (Eigen::Index i = 0; i < n; ++i) {
-        Vec3 target = s.pin_target.col(i);
-        for (int pass = 0; pass < 16; ++pass) {  // overlapping ellipsoids (arm and chest) take a few
-            bool moved = false;
-            for (const EllipsoidFrame& f : s.pin_frames) {
-                if (!f.active) continue;
-                const Vec3 out = leave_ellipsoid(f, target);
-                moved = moved || out != target;
-                target = out;
+    // Each pin on its own: a big garment's pins in as many ranges as it has parts.
+    const std::size_t parts = s.parts.count;
+    for_each_part(parts, [&](std::size_t k) {
+        const Eigen::Index begin = n * static_cast<Eigen::Index>(k) / static_cast<Eigen::Index>(parts);
+        const Eigen::Index end = n * static_cast<Eigen::Index>(k + 1) / static_cast<Eigen::Index>(parts);
+        for (Eigen::Index i = begin; i < end; ++i) {
+            Vec3 target = s.pin_target.col(i);
+            if (auto p = evaluate_pin(registry, g, pins[static_cast<std::size_t>(i)])) target = *p;
+            for (int pass = 0; pass < 16; ++pass) {  // overlapping ellipsoids (arm and chest) take a few
+                bool moved = false;
+                for (const EllipsoidFrame& f : s.pin_frames) {
+                    if (!f.active) continue;
+                    const Vec3 out = leave_ellipsoid(f, target);
+                    moved = moved || out != target;
+                    target = out;
+                }
+                if (!moved) break;
             }
-            if (!moved) break;
+            s.pin_target.col(i) = target;
         }
-        s.pin_target.col(i) = target;
-    }
+    });
     if (first || snap) s.pin_previous = s.pin_target;
 }
 

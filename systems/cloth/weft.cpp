@@ -3,8 +3,9 @@
 
 namespace drape {
 
-void carry_weft(const Fabric& t, const VectorX& inv_mass, const Matrix3X& x_start, Matrix3X& x) {
-    for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
+void carry_weft(const Fabric& t, std::span<const std::uint32_t> entries, const VectorX& inv_mass, const Matrix3X& x_start,
+                Matrix3X& x) {
+    for (const std::uint32_t k : entries) {
         const std::uint32_t p = t.weft_particle[k], a = t.weft_left[k], b = t.weft_right[k];
         if (inv_mass[p] == 0) continue;  // pinned in the fitting zone
         const Real s = t.weft_t[k];

@@ -14,14 +14,19 @@
 // 24 % (docs/cloth.md, "Choices the paper leaves open").
 #pragma once
 
+#include <cstdint>
+#include <span>
+
 #include "components/garment.hpp"
 #include "engine/core/math.hpp"
 
 namespace drape {
 
-/// Carries every free layer-2 particle of `fabric` with its neighbours: `x_start` are the
+/// Carries free layer-2 particles of `fabric` with its neighbours: `x_start` are the
 /// positions at the start of the substep, `x` holds layer 1 predicted and layer 2 as it was;
 /// on return layer 2 has moved as above. Pinned particles (`inv_mass` 0) are left alone.
-void carry_weft(const Fabric& fabric, const VectorX& inv_mass, const Matrix3X& x_start, Matrix3X& x);
+/// `entries`: the Fabric::weft_particle entries to carry.
+void carry_weft(const Fabric& fabric, std::span<const std::uint32_t> entries, const VectorX& inv_mass,
+                const Matrix3X& x_start, Matrix3X& x);
 
 }  // namespace drape

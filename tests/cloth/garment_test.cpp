@@ -324,5 +324,88 @@ TEST(Determinism, OneOrTwoThreadsGiveIdenticalBytes) {
     EXPECT_TRUE(same_bytes(simulate_crowd(1, 4, 60), simulate_crowd(2, 4, 60)));
 }
 
+// A dress (two parts, garment_parts.hpp) on a walking body, its own work spread over
+// `threads` threads.
+struct DressRun {
+    Matrix3X x, v;
+    std::uint64_t collision_tests = 0, collisions = 0, list_tests = 0;
+    std::size_t parts = 0;
+};
+
+DressRun simulate_dress(int threads, int frames) {
+    tbb::global_control control(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    Registry registry;
+    Scheduler scheduler;
+    test::AnalyticBody body(registry);
+    scheduler.add(body.system(registry));
+    const Entity e = *attach_dress(registry, body.character, TubeParams::dress());
+    add_cloth_systems(scheduler);
+    for (int f = 0; f < frames; ++f) (void)scheduler.tick(registry, 1.0 / 60.0);
+    const Garment& g = registry.get<Garment>(e);
+    return {g.state.x, g.state.v, g.counters.collision_tests, g.counters.collisions, g.counters.list_rebuild_tests,
+            registry.get<GarmentSolver>(e).parts.count};
+}
+
+TEST(Determinism, ABigGarmentsOwnWorkOnOneTwoOrThreeThreadsGivesIdenticalBytes) {
+    const DressRun one = simulate_dress(1, 40);
+    ASSERT_GE(one.parts, 2u);  // the dress is cut into parts that threads take
+    EXPECT_GT(one.collisions, 0u);
+    for (int threads : {2, 3}) {
+        const DressRun many = simulate_dress(threads, 40);
+        EXPECT_TRUE(same_bytes(one.x, many.x)) << threads << " threads";
+        EXPECT_TRUE(same_bytes(one.v, many.v)) << threads << " threads";
+        EXPECT_EQ(one.collision_tests, many.collision_tests);
+        EXPECT_EQ(one.collisions, many.collisions);
+        EXPECT_EQ(one.list_tests, many.list_tests);
+    }
+}
+
+TEST(Parts, BandsAndRangesCoverEveryParticleOnceAndEverySpringStaysInItsBand) {
+    Registry registry;
+    test::AnalyticBody body(registry);
+    const Entity e = *attach_dress(registry, body.character, TubeParams::dress());
+    const Garment& g = registry.get<Garment>(e);
+    const GarmentSolver& s = registry.get<GarmentSolver>(e);
+    const GarmentParts& parts = s.parts;
+    ASSERT_GE(parts.count, 2u);
+    const std::size_t n = g.fabric->particle_count();
+    for (const auto* runs : {&parts.row_runs, &parts.line_runs}) {
+        std::vector<int> seen(n, 0);
+        for (std::size_t k = 0; k < parts.count; ++k)
+            for (const ParticleRun& r : (*runs)[k])
+                for (Eigen::Index p = r.begin; p < r.end; ++p) ++seen[static_cast<std::size_t>(p)];
+        EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(n));
+    }
+    Eigen::Index next = 0;
+    for (const ParticleRun& r : parts.particles) {
+        EXPECT_EQ(r.begin, next);
+        EXPECT_EQ(r.begin % 64, 0);
+        next = r.end;
+    }
+    EXPECT_EQ(next, static_cast<Eigen::Index>(n));
+    // Every spring of part k has both ends in band k, and no spring is lost or repeated.
+    for (const SpringSet& set : s.springs) {
+        const std::vector<std::uint32_t>& band = set.by_lines ? parts.line_band : parts.row_band;
+        std::vector<int> solved(set.springs->size(), 0);
+        for (std::size_t k = 0; k < parts.count; ++k)
+            for (const SpringStrip& st : set.parts[k])
+                for (std::uint32_t i = 0; i < st.count; ++i) {
+                    const std::uint32_t spring = st.first + i * st.stride;
+                    ++solved[spring];
+                    EXPECT_EQ(set.springs->a[spring], st.a + i * st.stride);
+                    EXPECT_EQ(set.springs->b[spring], st.b + i * st.stride);
+                    EXPECT_EQ(band[st.a + i * st.stride], k);
+                    EXPECT_EQ(band[st.b + i * st.stride], k);
+                }
+        EXPECT_EQ(std::count(solved.begin(), solved.end(), 1), static_cast<std::ptrdiff_t>(solved.size()));
+    }
+    // A layer-2 particle's chord ends are in its row band.
+    for (std::size_t k = 0; k < parts.count; ++k)
+        for (std::uint32_t entry : parts.weft_entries[k]) {
+            EXPECT_EQ(parts.row_band[g.fabric->weft_left[entry]], k);
+            EXPECT_EQ(parts.row_band[g.fabric->weft_right[entry]], k);
+        }
+}
+
 }  // namespace
 }  // namespace drape

@@ -21,7 +21,7 @@ TEST(FreeFall, MatchesTheSchemeAndTheAnalyticSolutionWithinItsKnownError) {
     const Real h = Real(1.0 / 120.0);
     const Vec3 g(0, -standard_gravity_m_s2, 0);
     for (int n = 1; n <= 120; ++n) {
-        predict_particles(x, v, inv_mass, drag, 1, AnchorMotion{}, InertiaScales{}, g, h);
+        predict_particles(x, v, inv_mass, drag, 0, 1, AnchorMotion{}, InertiaScales{}, g, h);
         const double t = n * double(h);
         const double scheme = -double(standard_gravity_m_s2) * double(h) * double(h) * n * (n + 1) / 2;
         const double exact = -double(standard_gravity_m_s2) * t * t / 2;
@@ -67,7 +67,7 @@ TEST(Drag, SlowsAParticleAsTheSchemeSays) {
     const VectorX inv_mass = VectorX::Constant(1, 1 / m), drag = VectorX::Constant(1, k);
     const Vec3 v0 = v.col(0);
     for (int n = 1; n <= 240; ++n) {
-        predict_particles(x, v, inv_mass, drag, 1, AnchorMotion{}, InertiaScales{}, Vec3::Zero(), h);
+        predict_particles(x, v, inv_mass, drag, 0, 1, AnchorMotion{}, InertiaScales{}, Vec3::Zero(), h);
         const double factor = std::pow(1 - double(h * k / m), n);
         ASSERT_NEAR((Vec3(v.col(0)) - v0 * Real(factor)).norm(), 0, 1e-4) << "step " << n;
     }
@@ -117,7 +117,7 @@ Carried carry(const InertiaScales& inertia, int steps, double h, const Vec3& x0,
         m.velocity_before_m_s = v_before;
         m.angular_velocity_before_rad_s = w_before;
         m.acceleration_m_s2 = (m.velocity_m_s - v_before) / Real(h);
-        predict_particles(x, v, inv_mass, drag, 1, m, inertia, gravity, Real(h));
+        predict_particles(x, v, inv_mass, drag, 0, 1, m, inertia, gravity, Real(h));
         v_before = m.velocity_m_s;
         w_before = m.angular_velocity_rad_s;
     }
@@ -200,7 +200,7 @@ TEST(AnchorFrame, LinearInertiaScaleSetsHowMuchOfTheBodysJerkTheParticleFeels) {
         const Real h = Real(1.0 / 60.0);
         m.c1 = m.velocity_m_s * h;
         m.acceleration_m_s2 = m.velocity_m_s / h;
-        predict_particles(x, v, inv_mass, drag, 1, m, InertiaScales{s, 1}, Vec3::Zero(), h);
+        predict_particles(x, v, inv_mass, drag, 0, 1, m, InertiaScales{s, 1}, Vec3::Zero(), h);
         EXPECT_NEAR(v(0, 0), (1 - s) * 2, 1e-5) << "s = " << s;
         EXPECT_NEAR(x(0, 0), (1 - s) * 2 * h, 1e-6) << "s = " << s;
     }
@@ -233,7 +233,7 @@ TEST(AnchorFrame, LinearInertiaScaleInAnAcceleratingFrameGivesTheAnalyticDisplac
                 m.acceleration_m_s2 = a;
                 c += m.velocity_m_s * Real(h);
                 m.c1 = c;
-                predict_particles(x, v, inv_mass, drag, 1, m, InertiaScales{s, 1}, g, Real(h));
+                predict_particles(x, v, inv_mass, drag, 0, 1, m, InertiaScales{s, 1}, g, Real(h));
                 v_before = m.velocity_m_s;
             }
             const Eigen::Vector3d gd = g.cast<double>(), ad = a.cast<double>();
@@ -257,7 +257,7 @@ TEST(CompliantSpring, SettlesAtTheStaticStretchForAnyStiffnessAndStep) {
             phase.add(0, 1, 1);
             SpringSet set;
             set.springs = &phase;
-            set.strips = spring_strips(phase);
+            set.parts = {spring_strips(phase)};
             set.compliance = {1 / k};
             set.lambda = {0};
             const Real m = Real(0.1);
@@ -270,11 +270,11 @@ TEST(CompliantSpring, SettlesAtTheStaticStretchForAnyStiffnessAndStep) {
             Matrix3XRows rows;
             for (int n = 0; n < static_cast<int>(20 / h); ++n) {
                 const Matrix3X start = x;
-                predict_particles(x, v, inv_mass, drag, 2, AnchorMotion{}, InertiaScales{},
+                predict_particles(x, v, inv_mass, drag, 0, 2, AnchorMotion{}, InertiaScales{},
                                   Vec3(0, -standard_gravity_m_s2, 0), h);
                 set.lambda[0] = 0;
                 rows = x;
-                for (int round = 0; round < 4; ++round) solve_springs(set, rows, inv_mass, h, Real(10));
+                for (int round = 0; round < 4; ++round) solve_springs(set, 0, rows, inv_mass, h, Real(10));
                 x = rows;
                 v = (x - start) / h;
                 v.col(0).setZero();
@@ -293,7 +293,7 @@ TEST(CompliantSpring, ProvotsLimitCutsAnOverStretchedSpringBackToTheLimit) {
     phase.add(0, 1, 1);
     SpringSet set;
     set.springs = &phase;
-    set.strips = spring_strips(phase);
+    set.parts = {spring_strips(phase)};
     set.compliance = {Real(1e30)};  // no force: the limit alone
     set.lambda = {0};
     Matrix3XRows x(3, 2);
@@ -301,7 +301,7 @@ TEST(CompliantSpring, ProvotsLimitCutsAnOverStretchedSpringBackToTheLimit) {
     x.col(1) = Vec3(0, -3, 0);
     VectorX inv_mass(2);
     inv_mass << 0, 10;
-    solve_springs(set, x, inv_mass, Real(1.0 / 60.0), Real(0.1));
+    solve_springs(set, 0, x, inv_mass, Real(1.0 / 60.0), Real(0.1));
     EXPECT_EQ(Vec3(x.col(0)), Vec3::Zero());
     EXPECT_NEAR((x.col(1) - x.col(0)).norm(), 1.1, 1e-5);
 }
