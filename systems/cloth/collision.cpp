@@ -654,7 +654,7 @@ void prepare_candidate_lists(Garment& g, GarmentSolver& solver) {
     CandidateLists& lists = solver.lists;
     const Eigen::Index n = g.state.x.cols();
     const std::size_t e_count = std::min<std::size_t>(solver.frames.size(), 64);
-    const std::size_t parts = solver.parts.particles.size();
+    const std::size_t parts = solver.parts.runs.size();
     const bool valid = lists.valid && lists.parts.size() == parts && lists.reference_x.cols() == n &&
                        lists.clearance_m.rows() == n && lists.clearance_m.cols() == static_cast<Eigen::Index>(e_count) &&
                        lists.bits.size() == static_cast<std::size_t>(n) &&
@@ -675,7 +675,7 @@ void prepare_candidate_lists(Garment& g, GarmentSolver& solver) {
 void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t part_index, PartCounters& counters) {
     CandidateLists& lists = solver.lists;
     CandidateListPart& part = lists.parts[part_index];
-    const auto [first, n] = solver.parts.particles[part_index];
+    const std::vector<ParticleRun>& runs = solver.parts.runs[part_index];
     const std::size_t e_count = std::min<std::size_t>(solver.frames.size(), 64);
     const Affine3 anchor = anchor_frame(solver.frames, g.body.anchor);
     const Mat3 to_anchor = anchor.linear().transpose();  // rigid: inverse = transpose
@@ -684,9 +684,11 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
     VectorX& slack = lists.slack_m;
     std::uint64_t tests = 0;
 
-    // 1. Each particle's position and move d_p in the anchor frame (whole arrays).
+    // 1. Each particle's position and move d_p in the anchor frame (whole runs).
     Matrix3XRows& local = lists.scratch;
-    {
+    const bool rebuild = !part.valid;  // every particle and every ellipsoid is its own reference
+    if (rebuild) part.reference_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
+    for (const auto [first, n] : runs) {
         // One pass with stride-3 loads; the rows of `local` are contiguous.
         const Vec3 t = anchor.translation();
         const Real* x = g.state.x.data();
@@ -700,28 +702,25 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
             l1[p] = r(1, 0) * a + r(1, 1) * b + r(1, 2) * c;
             l2[p] = r(2, 0) * a + r(2, 1) * b + r(2, 2) * c;
         }
-    }
-    const Eigen::Index count = n - first;
-    if (!part.valid) {  // every particle and every ellipsoid is its own reference
-        lists.reference_x.middleCols(first, count) = local.middleCols(first, count);
-        part.reference_frames.assign(e_count, Affine3(Eigen::Matrix<Real, 4, 4>::Zero()));
-    }
-    {
+        const Eigen::Index count = n - first;
+        if (rebuild) lists.reference_x.middleCols(first, count) = local.middleCols(first, count);
         const auto d = (local.middleCols(first, count) - lists.reference_x.middleCols(first, count)).array();
         slack.segment(first, count) = (d.row(0).square() + d.row(1).square() + d.row(2).square()).sqrt().transpose();
     }
 
     // 2. Ellipsoids: refresh bit e against the particles' reference points when e has moved
     //    its share since its reference pose, which it then becomes. D_e: its move since.
-    std::optional<BlockBounds> bounds;  // of the reference points, on first use
+    std::vector<BlockBounds> bounds;  // of the reference points of each run, on first use
     const Real ellipsoid_limit = ellipsoid_refresh_share * margin;
     std::array<Real, 64> moved_since{};
     for (std::size_t e = 0; e < e_count; ++e) {
         Affine3& then = part.reference_frames[e];
         if (!solver.frames[e].active) {
             if (has_reference(then)) {
-                for (Eigen::Index p = first; p < n; ++p) lists.bits[static_cast<std::size_t>(p)] &= ~(std::uint64_t(1) << e);
-                clearance.col(static_cast<Eigen::Index>(e)).segment(first, count).setConstant(std::numeric_limits<Real>::infinity());
+                for (const auto [first, n] : runs) {
+                    for (Eigen::Index p = first; p < n; ++p) lists.bits[static_cast<std::size_t>(p)] &= ~(std::uint64_t(1) << e);
+                    clearance.col(static_cast<Eigen::Index>(e)).segment(first, n - first).setConstant(std::numeric_limits<Real>::infinity());
+                }
                 then.matrix().setZero();
             }
             continue;
@@ -733,9 +732,11 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
             moved_since[e] = moved;
             continue;
         }
-        if (!bounds) bounds.emplace(lists.reference_x, first, n);
-        tests += refresh_bit(lists.reference_x, first, n, *bounds, ListEllipsoid(current), e, margin, lists.bits,
-                             clearance.col(static_cast<Eigen::Index>(e)).data());
+        if (bounds.empty())
+            for (const auto [first, n] : runs) bounds.emplace_back(lists.reference_x, first, n);
+        for (std::size_t r = 0; r < runs.size(); ++r)
+            tests += refresh_bit(lists.reference_x, runs[r].begin, runs[r].end, bounds[r], ListEllipsoid(current), e, margin,
+                                 lists.bits, clearance.col(static_cast<Eigen::Index>(e)).data());
         then = now;
     }
 
@@ -744,44 +745,47 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
     //    columns. A particle without slack becomes its own reference and is tested against
     //    every reference ellipsoid.
     const std::uint64_t active = active_mask(solver.frames);
-    VectorX room = VectorX::Constant(count, std::numeric_limits<Real>::infinity());
-    for_each_bit(active, [&](int e) {
-        const Real* c = clearance.col(e).data() + first;
-        const Real moved = moved_since[static_cast<std::size_t>(e)];
-        Real* r = room.data();
-        for (Eigen::Index p = 0; p < count; ++p) r[p] = std::min(r[p], c[p] - moved);
-    });
-    slack.segment(first, count) = room - slack.segment(first, count);
     std::optional<ReferenceLanes> references;  // on first use
     alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
-    // The particles without slack, gathered without a branch per particle; pinned ones are
-    // never tested (method §3.5).
     std::vector<Eigen::Index>& spent = part.spent;
-    spent.resize(static_cast<std::size_t>(count));
-    std::size_t spent_count = 0;
-    for (Eigen::Index begin = first; begin < n; begin += 16) {
-        const Eigen::Index end = std::min<Eigen::Index>(begin + 16, n);
-        if (end - begin == 16 && Eigen::Map<const Eigen::Array<Real, 16, 1>>(slack.data() + begin).minCoeff() >= 0) continue;
-        for (Eigen::Index p = begin; p < end; ++p) {
-            spent[spent_count] = p;
-            spent_count += static_cast<std::size_t>(slack[p] < 0) & static_cast<std::size_t>(g.state.inv_mass[p] != 0);
+    for (const auto [first, n] : runs) {
+        const Eigen::Index count = n - first;
+        VectorX room = VectorX::Constant(count, std::numeric_limits<Real>::infinity());
+        for_each_bit(active, [&](int e) {
+            const Real* c = clearance.col(e).data() + first;
+            const Real moved = moved_since[static_cast<std::size_t>(e)];
+            Real* r = room.data();
+            for (Eigen::Index p = 0; p < count; ++p) r[p] = std::min(r[p], c[p] - moved);
+        });
+        slack.segment(first, count) = room - slack.segment(first, count);
+        // The particles without slack, gathered without a branch per particle; pinned ones
+        // are never tested (method §3.5).
+        spent.resize(static_cast<std::size_t>(count));
+        std::size_t spent_count = 0;
+        for (Eigen::Index begin = first; begin < n; begin += 16) {
+            const Eigen::Index end = std::min<Eigen::Index>(begin + 16, n);
+            if (end - begin == 16 && Eigen::Map<const Eigen::Array<Real, 16, 1>>(slack.data() + begin).minCoeff() >= 0) continue;
+            for (Eigen::Index p = begin; p < end; ++p) {
+                spent[spent_count] = p;
+                spent_count += static_cast<std::size_t>(slack[p] < 0) & static_cast<std::size_t>(g.state.inv_mass[p] != 0);
+            }
         }
-    }
-    for (std::size_t k = 0; k < spent_count; ++k) {
-        const Eigen::Index p = spent[k];
-        if (!references) {
-            references.emplace(e_count);
-            for_each_bit(active, [&](int e) {
-                const std::size_t ei = static_cast<std::size_t>(e);
-                references->set(ei, part.reference_frames[ei], moved_since[ei]);
-            });
+        for (std::size_t k = 0; k < spent_count; ++k) {
+            const Eigen::Index p = spent[k];
+            if (!references) {
+                references.emplace(e_count);
+                for_each_bit(active, [&](int e) {
+                    const std::size_t ei = static_cast<std::size_t>(e);
+                    references->set(ei, part.reference_frames[ei], moved_since[ei]);
+                });
+            }
+            lists.reference_x.col(p) = local.col(p);
+            Real left = 0;
+            lists.bits[static_cast<std::size_t>(p)] = references->test(local.col(p), margin, stored, left);
+            for (std::size_t e = 0; e < e_count; ++e) clearance(p, static_cast<Eigen::Index>(e)) = stored[e];
+            slack[p] = std::max(Real(0), left);
+            tests += static_cast<std::uint64_t>(std::popcount(active));
         }
-        lists.reference_x.col(p) = local.col(p);
-        Real left = 0;
-        lists.bits[static_cast<std::size_t>(p)] = references->test(local.col(p), margin, stored, left);
-        for (std::size_t e = 0; e < e_count; ++e) clearance(p, static_cast<Eigen::Index>(e)) = stored[e];
-        slack[p] = std::max(Real(0), left);
-        tests += static_cast<std::uint64_t>(std::popcount(active));
     }
     part.valid = true;
     counters.list_tests += tests;

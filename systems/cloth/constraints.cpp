@@ -82,27 +82,37 @@ void solve_strip(int count, Real* __restrict a0, Real* __restrict a1, Real* __re
 
 }  // namespace
 
-std::vector<std::vector<SpringStrip>> split_strips(const std::vector<SpringStrip>& strips,
-                                                 const std::vector<std::uint32_t>& band, std::size_t bands) {
-    std::vector<std::vector<SpringStrip>> parts(bands);
+BandStrips split_strips(const std::vector<SpringStrip>& strips, const std::vector<std::uint32_t>& band, std::size_t bands) {
+    BandStrips out;
+    out.parts.resize(bands);
     if (bands == 1) {
-        parts[0] = strips;
-        return parts;
+        out.parts[0] = strips;
+        return out;
     }
     for (const SpringStrip& st : strips) {
+        // Lane k's band, or bands (an edge spring) when its ends are in two.
+        const auto lane_band = [&](std::uint32_t k) {
+            const std::uint32_t a = band[st.a + k * st.stride], b = band[st.b + k * st.stride];
+            return a == b ? a : static_cast<std::uint32_t>(bands);
+        };
         std::uint32_t k = 0;
         while (k < st.count) {
-            const std::uint32_t b = band[st.a + k * st.stride];
+            const std::uint32_t b = lane_band(k);
             std::uint32_t len = 1;
-            while (k + len < st.count && band[st.a + (k + len) * st.stride] == b) ++len;
-            parts[b].push_back({st.a + k * st.stride, st.b + k * st.stride, st.first + k * st.stride, len, st.stride});
+            while (k + len < st.count && lane_band(k + len) == b) ++len;
+            for (std::uint32_t i = 0; i < (b == bands ? len : 1); ++i) {
+                const std::uint32_t first = k + i;
+                const SpringStrip piece{st.a + first * st.stride, st.b + first * st.stride, st.first + first * st.stride,
+                                        b == bands ? 1 : len, st.stride};
+                (b == bands ? out.edge : out.parts[b]).push_back(piece);
+            }
             k += len;
         }
     }
-    return parts;
+    return out;
 }
 
-void solve_springs(SpringSet& set, std::size_t part, Matrix3XRows& x, const VectorX& w, Real h, Real limit) {
+void solve_springs(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& w, Real h, Real limit) {
     Real* x0 = x.row(0).data();
     Real* x1 = x.row(1).data();
     Real* x2 = x.row(2).data();
@@ -112,7 +122,7 @@ void solve_springs(SpringSet& set, std::size_t part, Matrix3XRows& x, const Vect
     const Real* compliance = set.compliance.data();
     Real* lambda = set.lambda.data();
     const Real* wp = w.data();
-    for (const SpringStrip& st : set.parts[part]) {
+    for (const SpringStrip& st : set.strips.parts[band]) {
         const int count = static_cast<int>(st.count);
         const std::uint32_t a = st.a, b = st.b, f = st.first;
         if (st.stride == 1)
@@ -121,6 +131,17 @@ void solve_springs(SpringSet& set, std::size_t part, Matrix3XRows& x, const Vect
         else
             solve_strip<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, wp + a, wp + b, rest + f, compliance + f,
                            lambda + f, inv_h2, limit_scale);
+    }
+}
+
+void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& w, Real h, Real limit) {
+    const Real inv_h2 = 1 / (h * h);
+    const Real limit_scale = set.limited ? 1 + limit : std::numeric_limits<Real>::infinity();
+    for (const SpringStrip& st : set.strips.edge) {  // one spring each: a lane of one
+        Real* a = x.col(st.a).data();
+        Real* b = x.col(st.b).data();
+        solve_strip<1>(1, a, a + 1, a + 2, b, b + 1, b + 2, w.data() + st.a, w.data() + st.b, set.springs->rest_m.data() + st.first,
+                       set.compliance.data() + st.first, set.lambda.data() + st.first, inv_h2, limit_scale);
     }
 }
 

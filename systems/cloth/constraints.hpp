@@ -40,18 +40,21 @@ struct SpringStrip {
 /// then its odd ones; springs that fit no run become strips of one.
 [[nodiscard]] std::vector<SpringStrip> spring_strips(const SpringPhase& springs);
 
-/// The strips cut where `band` (per particle) changes along a strip: part k's strips, in
-/// solving order, hold the springs whose `a` end is in band k (both ends must be in the
-/// same band). One band gives the strips as they are.
-[[nodiscard]] std::vector<std::vector<SpringStrip>> split_strips(const std::vector<SpringStrip>& strips,
-                                                                 const std::vector<std::uint32_t>& band,
-                                                                 std::size_t bands);
+/// A phase's strips cut by bands (systems/cloth/garment_parts.hpp).
+struct BandStrips {
+    std::vector<std::vector<SpringStrip>> parts;  ///< Per band, in solving order: the springs with both ends in it.
+    std::vector<SpringStrip> edge;                ///< The springs joining two bands, one per strip.
+};
+
+/// `strips` cut where the band (per particle) of a lane's ends changes. One band gives the
+/// strips as they are.
+[[nodiscard]] BandStrips split_strips(const std::vector<SpringStrip>& strips, const std::vector<std::uint32_t>& band,
+                                      std::size_t bands);
 
 /// Springs of one phase as the solver sees them.
 struct SpringSet {
     const SpringPhase* springs = nullptr;
-    std::vector<std::vector<SpringStrip>> parts;  ///< Per band of the garment's parts (garment_parts.hpp): its strips.
-    bool by_lines = false;         ///< Cut by line bands (warp) rather than row bands.
+    BandStrips strips;             ///< By the garment's bands (garment_parts.hpp).
     std::vector<Real> compliance;  ///< Per spring: 1 / k, m/N (1e30: a spring without force).
     std::vector<Real> lambda;      ///< Per spring: XPBD multiplier of the current substep.
     bool limited = true;           ///< Provot's limit applies (structural springs).
@@ -61,9 +64,13 @@ struct SpringSet {
 /// `area` per particle; a modulus of 0 gives a spring without force (limit only).
 [[nodiscard]] std::vector<Real> spring_compliance(const SpringPhase& springs, const VectorX& area, Real modulus_N_m);
 
-/// One Gauss-Seidel round over part `part` of `set` (step 1) in a substep of h_s, strip by
+/// One Gauss-Seidel round over band `band` of `set` (step 1) in a substep of h_s, strip by
 /// strip, on positions held one row per coordinate. `inv_mass` 0 = does not move.
-void solve_springs(SpringSet& set, std::size_t part, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
+void solve_springs(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
+
+/// The same for the springs of `set` that join two bands, on positions held one column per
+/// particle.
+void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& inv_mass, Real h_s, Real limit);
 
 /// Long-range attachments (step 2): one per free particle below a pinned one on its line.
 struct Tethers {

@@ -410,7 +410,7 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
     t->grid.assign(n * m, 0);
     t->layer.assign(n * m, 0);
     t->line_bands = part_count(n, m);
-    const std::vector<std::uint32_t> edges = line_band_edges(n, stride, t->line_bands);
+    const std::vector<std::uint32_t> edges = line_band_edges(n, t->line_bands);
     std::uint32_t next = 0;
     for (std::uint32_t offset = 0; offset < stride; ++offset)
         for (std::uint32_t band = 0; band < t->line_bands; ++band)

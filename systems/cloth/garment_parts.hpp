@@ -1,20 +1,19 @@
 // A big garment's own work in fixed parts that threads can take (docs/cloth.md "Threads").
 //
-// A garment of many particles is cut, once, into `count` parts of each of three kinds, by
-// its grid alone (never by the number of threads):
-//   - row bands: the weft springs, which join particles of one row, the prediction of the
-//     band's integrated particles and the carriage of its layer-2 particles (whose chord
-//     ends are in the same row);
-//   - line bands: the warp springs, which join particles of one line, the tethers and the
-//     warp limit, both of which run along one line;
-//   - particle ranges (whole blocks of 64): collision with candidate lists of their own,
-//     and the velocities.
-// Parts of one kind share no particle, so they run at the same time in any order, and a
-// stage of one kind only starts when the stage before it has finished: each part does the
-// same arithmetic whichever thread takes it, and the garment ends every step in the same
-// bytes on one thread or many (tested). One part of each kind is the whole garment, in the
-// solver's order: a garment below `part_particles` x 2, and the classic model (its shear and
-// bend springs cross rows and lines), stay in one part.
+// A garment of many particles is cut, once, by its grid alone (never by the number of
+// threads), into `count` bands of neighbouring warp lines, and the fabric stores each
+// band's particles together (Fabric::line_bands). A band is a part of every stage: the
+// prediction of its integrated particles, the carriage of its layer-2 particles, its
+// springs, tethers and warp limit (all of which run along its lines or between them), its
+// collision with candidate lists of its own, and its velocities. What joins two bands, the
+// weft springs across a band edge and the layer-2 particles whose chord crosses one, is
+// done on one thread between the stages. Bands share no particle, so they run at the same
+// time in any order, and a stage only starts when the one before has finished: each band
+// does the same arithmetic whichever thread takes it, and the garment ends every step in
+// the same bytes on one thread or many (tested). Each thread keeps its band's particles
+// in its own cache from stage to stage. A garment below part_particles x 2, and the
+// classic model (its shear and bend springs cross bands), stay in one band, in the solver's
+// order.
 #pragma once
 
 #include <cstdint>
@@ -39,11 +38,8 @@ inline constexpr std::uint32_t max_parts = 8;
 /// lines or rows. The fabric stores its particles by this many line bands (line_band_of).
 [[nodiscard]] std::uint32_t part_count(std::uint32_t lines, std::uint32_t rows) noexcept;
 
-/// Line bands of a grid of `lines` lines, every `stride`-th of them layer 1: band k holds
-/// lines [edges[k], edges[k + 1]). The edges fall on whole multiples of 8 lines of each
-/// layer where the bands stay non-empty, so that a band's rows of warp springs run in whole
-/// 8-lane vectors (a 20-line band would end each of its strips in 4 scalar lanes).
-[[nodiscard]] std::vector<std::uint32_t> line_band_edges(std::uint32_t lines, std::uint32_t stride, std::uint32_t bands);
+/// The first line of each of `bands` bands of `lines` lines, and `lines` at the end.
+[[nodiscard]] std::vector<std::uint32_t> line_band_edges(std::uint32_t lines, std::uint32_t bands);
 
 /// The band of `line` by its edges.
 [[nodiscard]] std::uint32_t line_band_of(const std::vector<std::uint32_t>& edges, std::uint32_t line) noexcept;
@@ -53,19 +49,14 @@ struct ParticleRun {
     Eigen::Index begin = 0, end = 0;
 };
 
-/// Which band kind a spring set is cut by.
-enum class BandKind : std::uint8_t { rows, lines };
-
 struct GarmentParts {
     std::size_t count = 1;
-    std::vector<std::uint32_t> row_band;               ///< Per particle: its row band.
-    std::vector<std::uint32_t> line_band;              ///< Per particle: its line band.
-    std::vector<std::vector<ParticleRun>> row_runs;    ///< Per row band: its particles.
-    std::vector<std::vector<ParticleRun>> integrated_runs;  ///< Per row band: its integrated particles.
-    std::vector<std::vector<std::uint32_t>> weft_entries;   ///< Per row band: its Fabric::weft_particle entries.
-    std::vector<std::vector<ParticleRun>> line_runs;   ///< Per line band: its particles.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> lines;  ///< Per line band: its lines [first, end).
-    std::vector<ParticleRun> particles;                ///< Per particle range.
+    std::vector<std::uint32_t> band;                          ///< Per particle: its band.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> lines;  ///< Per band: its lines [first, end).
+    std::vector<std::vector<ParticleRun>> runs;               ///< Per band: its particles.
+    std::vector<std::vector<ParticleRun>> integrated_runs;    ///< Per band: its integrated particles.
+    std::vector<std::vector<std::uint32_t>> weft_entries;     ///< Per band: Fabric::weft_particle entries whose chord is in it.
+    std::vector<std::uint32_t> edge_weft_entries;             ///< The entries whose chord crosses a band edge.
 };
 
 /// The parts of `fabric` for `model` (fabric.line_bands of them for the simplified model, one

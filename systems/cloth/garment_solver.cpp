@@ -40,12 +40,10 @@ void derive_masses(const Garment& g, GarmentSolver& s) {
     s.drag_N_s_m = drag;
 }
 
-SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus, bool limited, const GarmentParts& parts,
-                     bool by_lines) {
+SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus, bool limited, const GarmentParts& parts) {
     SpringSet set;
     set.springs = &phase;
-    set.parts = split_strips(spring_strips(phase), by_lines ? parts.line_band : parts.row_band, parts.count);
-    set.by_lines = by_lines;
+    set.strips = split_strips(spring_strips(phase), parts.band, parts.count);
     set.compliance = spring_compliance(phase, area, modulus);
     set.lambda.assign(phase.size(), 0);
     set.limited = limited;
@@ -77,22 +75,21 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         const GarmentParts& parts = s.parts;
         s.springs.clear();
         if (simplified) {
-            // Weft springs (row bands), then the warp (line bands): layer 1's (with the areas
-            // its particles stand for), then layer 2's.
-            s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true, parts, false));
-            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts, true));
-            s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true, parts, true));
+            // Weft springs, then the warp: layer 1's (with the areas its particles stand for),
+            // then layer 2's.
+            s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true, parts));
+            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts));
+            s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true, parts));
         } else {
             // Shear and bend first: the structural springs and their limit have the last word.
-            // One part (garment_parts.hpp): every set in the row stage, in this order.
-            s.springs.push_back(spring_set(t.shear, area, m.shear_N_m, false, parts, false));
-            s.springs.push_back(spring_set(t.bend, area, m.bend_N_m, false, parts, false));
-            s.springs.push_back(spring_set(t.weft, area, m.stretch_N_m, true, parts, false));
-            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts, false));
-            s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true, parts, false));
+            s.springs.push_back(spring_set(t.shear, area, m.shear_N_m, false, parts));
+            s.springs.push_back(spring_set(t.bend, area, m.bend_N_m, false, parts));
+            s.springs.push_back(spring_set(t.weft, area, m.stretch_N_m, true, parts));
+            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts));
+            s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true, parts));
         }
         s.warp_rest_above = warp_rest_above(t);
-        s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.line_band, parts.count);
+        s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.band, parts.count);
         s.below.resize(static_cast<std::size_t>(n));
         const std::uint32_t rows = t.particles_per_line;
         for (std::uint32_t line = 0; line < t.warp_lines; ++line)

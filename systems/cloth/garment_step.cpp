@@ -76,9 +76,9 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
     const Vec3 gravity(0, -standard_gravity_m_s2, 0);
     const Real h = static_cast<Real>(sub.h_s);
     const bool carry = g.config.model == ClothModel::simplified;
-    // Row bands (garment_parts.hpp): a layer-2 particle's chord ends are in its row.
+    // Band by band (garment_parts.hpp).
     for_each_part(s.parts.count, [&](std::size_t k) {
-        for (const ParticleRun& r : s.parts.row_runs[k]) {
+        for (const ParticleRun& r : s.parts.runs[k]) {
             const Eigen::Index count = r.end - r.begin;
             s.x_start.middleCols(r.begin, count) = state.x.middleCols(r.begin, count);
             s.push.middleCols(r.begin, count).setZero();
@@ -89,6 +89,8 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
         // §4.2: layer 2 is carried by the layer 1 it hangs between (weft.hpp).
         if (carry) carry_weft(*g.fabric, s.parts.weft_entries[k], state.inv_mass, s.x_start, state.x);
     });
+    // Then the layer-2 particles whose chord crosses a band edge, both ends now predicted.
+    if (carry) carry_weft(*g.fabric, s.parts.edge_weft_entries, state.inv_mass, s.x_start, state.x);
     s.anchor_velocity_before = motion.velocity_m_s;
     s.anchor_angular_before = motion.angular_velocity_rad_s;
     s.anchor_known = true;
@@ -110,20 +112,16 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
     const Real h = static_cast<Real>(sub.h_s);
     const Real limit = g.config.material.strain_limit;
     const bool tethers = round + 1 == constraint_rounds(g);
-    // Row bands: positions in, one row per coordinate (the strips run in vector lanes), then
-    // the sets cut by rows (the weft; every set of the classic model, in one part).
+    // The springs joining two bands first, on this thread (none in a garment of one band).
+    for (SpringSet& set : s.springs) solve_edge_springs(set, x, s.inv_mass, h, limit);
+    // Then band by band: positions in, one row per coordinate (the strips run in vector
+    // lanes), every set in order, in the last round the tethers, positions out.
     for_each_part(s.parts.count, [&](std::size_t k) {
-        for (const ParticleRun& r : s.parts.row_runs[k])
+        for (const ParticleRun& r : s.parts.runs[k])
             s.x_rows.middleCols(r.begin, r.end - r.begin) = x.middleCols(r.begin, r.end - r.begin);
-        for (SpringSet& set : s.springs)
-            if (!set.by_lines) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
-    });
-    // Line bands: the warp sets, in the last round the tethers, then positions out.
-    for_each_part(s.parts.count, [&](std::size_t k) {
-        for (SpringSet& set : s.springs)
-            if (set.by_lines) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
+        for (SpringSet& set : s.springs) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
         if (tethers) solve_tethers(s.tethers[k], s.x_rows);
-        for (const ParticleRun& r : s.parts.line_runs[k])
+        for (const ParticleRun& r : s.parts.runs[k])
             x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);
     });
 }
@@ -137,12 +135,13 @@ void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSub
     Matrix3X& x = g.state.x;
     for_each_part(s.parts.count, [&](std::size_t k) {
         PartCounters& c = s.part_counters[k] = PartCounters{};
-        const auto [first, end] = s.parts.particles[k];
         if (lists) update_candidate_part(g, s, k, c);
-        s.x_round.middleCols(first, end - first) = x.middleCols(first, end - first);
-        collide_part(g, s, x, g.state.v, first, end, /*respond_velocity=*/false, c);
-        for (Eigen::Index p = first; p < end; ++p) s.contacts[static_cast<std::size_t>(p)] |= s.last_collided[static_cast<std::size_t>(p)];
-        s.push.middleCols(first, end - first) += x.middleCols(first, end - first) - s.x_round.middleCols(first, end - first);
+        for (const auto [first, end] : s.parts.runs[k]) {
+            s.x_round.middleCols(first, end - first) = x.middleCols(first, end - first);
+            collide_part(g, s, x, g.state.v, first, end, /*respond_velocity=*/false, c);
+            for (Eigen::Index p = first; p < end; ++p) s.contacts[static_cast<std::size_t>(p)] |= s.last_collided[static_cast<std::size_t>(p)];
+            s.push.middleCols(first, end - first) += x.middleCols(first, end - first) - s.x_round.middleCols(first, end - first);
+        }
     });
     for (const PartCounters& c : s.part_counters) add_part_counters(g, c);
 }
@@ -209,31 +208,31 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Ei
 }
 
 // The warp limit moved particles after the last collision round (on the sample scene's walk
-// 153 of 837 per substep, 61 of them by a millimetre or more): in particle range `part`,
-// each block of 64 particles holding one is collided again, in the garment's collision mode
-// (the range's lists brought up to date first), positions only; the last round's contacts
-// are kept.
+// 153 of 837 per substep, 61 of them by a millimetre or more): in band `part`, each block of
+// 64 particles holding one is collided again, in the garment's collision mode (the band's
+// lists brought up to date first), positions only; the last round's contacts are kept.
 void collide_warp_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCounters& c) {
     constexpr Eigen::Index block = 64;
-    const auto [first, n] = s.parts.particles[part];
     bool lists_current = false;
     std::array<std::uint64_t, block> before{};
-    for (Eigen::Index begin = first; begin < n; begin += block) {
-        const Eigen::Index end = std::min(begin + block, n);
-        if (s.warp_moves.middleCols(begin, end - begin).cwiseAbs().maxCoeff() == 0) continue;
-        if (!lists_current && g.config.collision == CollisionMode::candidate_lists) {
-            update_candidate_part(g, s, part, c);
-            lists_current = true;
+    for (const auto [first, n] : s.parts.runs[part]) {
+        for (Eigen::Index begin = first; begin < n; begin += block) {
+            const Eigen::Index end = std::min(begin + block, n);
+            if (s.warp_moves.middleCols(begin, end - begin).cwiseAbs().maxCoeff() == 0) continue;
+            if (!lists_current && g.config.collision == CollisionMode::candidate_lists) {
+                update_candidate_part(g, s, part, c);
+                lists_current = true;
+            }
+            s.x_round.middleCols(begin, end - begin) = g.state.x.middleCols(begin, end - begin);
+            std::copy(s.last_collided.begin() + begin, s.last_collided.begin() + end, before.begin());
+            collide_part(g, s, g.state.x, g.state.v, begin, end, /*respond_velocity=*/false, c);
+            for (Eigen::Index p = begin; p < end; ++p) {
+                const std::size_t i = static_cast<std::size_t>(p);
+                s.contacts[i] |= s.last_collided[i];
+                s.last_collided[i] |= before[static_cast<std::size_t>(p - begin)];  // last round's contacts stay
+            }
+            s.push.middleCols(begin, end - begin) += g.state.x.middleCols(begin, end - begin) - s.x_round.middleCols(begin, end - begin);
         }
-        s.x_round.middleCols(begin, end - begin) = g.state.x.middleCols(begin, end - begin);
-        std::copy(s.last_collided.begin() + begin, s.last_collided.begin() + end, before.begin());
-        collide_part(g, s, g.state.x, g.state.v, begin, end, /*respond_velocity=*/false, c);
-        for (Eigen::Index p = begin; p < end; ++p) {
-            const std::size_t i = static_cast<std::size_t>(p);
-            s.contacts[i] |= s.last_collided[i];
-            s.last_collided[i] |= before[static_cast<std::size_t>(p - begin)];  // last round's contacts stay
-        }
-        s.push.middleCols(begin, end - begin) += g.state.x.middleCols(begin, end - begin) - s.x_round.middleCols(begin, end - begin);
     }
 }
 
@@ -253,10 +252,12 @@ void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, co
     if (moved && g.config.collision == CollisionMode::candidate_lists) prepare_candidate_lists(g, s);
     for_each_part(s.parts.count, [&](std::size_t k) {
         PartCounters& c = s.part_counters[k] = PartCounters{};
-        const auto [first, end] = s.parts.particles[k];
         if (moved) collide_warp_moves(g, s, k, c);
-        update_velocities(g, s, sub, first, end);
-        c.finite = all_finite(g.state.x.middleCols(first, end - first)) && all_finite(g.state.v.middleCols(first, end - first));
+        for (const auto [first, end] : s.parts.runs[k]) {
+            update_velocities(g, s, sub, first, end);
+            c.finite = c.finite && all_finite(g.state.x.middleCols(first, end - first)) &&
+                       all_finite(g.state.v.middleCols(first, end - first));
+        }
     });
     bool finite = true;
     for (const PartCounters& c : s.part_counters) {

@@ -257,7 +257,7 @@ TEST(CompliantSpring, SettlesAtTheStaticStretchForAnyStiffnessAndStep) {
             phase.add(0, 1, 1);
             SpringSet set;
             set.springs = &phase;
-            set.parts = {spring_strips(phase)};
+            set.strips.parts = {spring_strips(phase)};
             set.compliance = {1 / k};
             set.lambda = {0};
             const Real m = Real(0.1);
@@ -293,7 +293,7 @@ TEST(CompliantSpring, ProvotsLimitCutsAnOverStretchedSpringBackToTheLimit) {
     phase.add(0, 1, 1);
     SpringSet set;
     set.springs = &phase;
-    set.parts = {spring_strips(phase)};
+    set.strips.parts = {spring_strips(phase)};
     set.compliance = {Real(1e30)};  // no force: the limit alone
     set.lambda = {0};
     Matrix3XRows x(3, 2);
