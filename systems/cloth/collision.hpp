@@ -17,6 +17,8 @@
 //      refreshed in every list (a fast shin often, the pelvis rarely; blocks of particles
 //      whose box is far from it are cleared untested); a particle with no slack left,
 //      min_e (C_pe - D_e) - d_p, gets its whole list refreshed. The slack is kept for step 3.
+//      A garment cut into bands (garment_parts.hpp) keeps the ellipsoid references per band,
+//      so that bands are brought up to date independently, on different threads.
 //   2. Detection: in list mode 64 consecutive particles are tested at once against every
 //      ellipsoid of their lists (vector lanes outside a particle's list are discarded and not
 //      counted); brute force tests every ellipsoid. Last substep's contacts are answered
