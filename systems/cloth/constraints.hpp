@@ -12,7 +12,9 @@
 //      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
 //      line's weight up to its pin, the tether does it in one).
 // After the rounds, once per substep, limit_warp_lines holds every warp spring within half
-// the limit by a one-sided pass from the pins down (follow the leader).
+// the limit by a one-sided pass from the pins down (follow the leader), then
+// limit_weft_rows holds every weft row the same, each run of over-long springs solved as
+// one chain.
 // Positions only: the velocities follow from the whole substep's move afterwards
 // (garment_step.hpp), as Provot's velocities follow his corrections.
 #pragma once
@@ -104,5 +106,25 @@ void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 /// particles moved.
 std::uint64_t limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real stretch,
                       Matrix3X& x, Matrix3X& moves, std::uint32_t first_line, std::uint32_t end_line);
+
+/// Per particle: rest length of the weft spring to its neighbour on the next line (0 for
+/// none).
+[[nodiscard]] VectorX weft_rest_right(const Fabric& fabric);
+
+/// Passes of limit_weft_rows, and how far over its bound (a share of the rest length) a
+/// spring must be for a pass to act on its row.
+inline constexpr int weft_limit_passes = 3;
+inline constexpr Real weft_limit_tolerance = Real(0.01);
+
+/// After the rounds, with the warp limit: Provot's limit along every weft row [first_row,
+/// end_row) at once (an extension of method §4.1). Where a spring of a row is longer than
+/// (1 + stretch) x rest by more than weft_limit_tolerance x rest, every run of neighbouring
+/// springs over (1 + stretch) x rest is brought back to that length together, as one chain:
+/// the run's linearised constraints, a tridiagonal system, solved directly, its moves
+/// shared by inverse mass (a pinned end stays). A few passes (weft_limit_passes) take up
+/// what the linearisation leaves. Rows are independent of each other. `moves` receives
+/// each particle of the rows' move (zero for the rest). Returns the spring corrections made.
+std::uint64_t limit_weft_rows(const Fabric& fabric, const VectorX& rest_right, const VectorX& inv_mass, Real stretch,
+                              Matrix3X& x, Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row);
 
 }  // namespace drape

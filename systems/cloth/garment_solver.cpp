@@ -89,6 +89,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true, parts));
         }
         s.warp_rest_above = warp_rest_above(t);
+        s.weft_rest_right = weft_rest_right(t);
         s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.band, parts.count);
         s.below.resize(static_cast<std::size_t>(n));
         const std::uint32_t rows = t.particles_per_line;
@@ -103,6 +104,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.configured = true;
     }
     if (s.warp_moves.cols() != n) s.warp_moves = Matrix3X::Zero(3, n);
+    if (s.weft_moves.cols() != n) s.weft_moves = Matrix3X::Zero(3, n);
     if (s.x_round.cols() != n) s.x_round = Matrix3X::Zero(3, n);
     if (s.x_start.cols() != n) s.x_start = Matrix3X::Zero(3, n);
     if (s.push.cols() != n) s.push = Matrix3X::Zero(3, n);

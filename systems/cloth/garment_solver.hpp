@@ -55,6 +55,7 @@ struct PartCounters {
     std::uint64_t collision_tests = 0, collisions = 0, list_tests = 0, list_rebuilds = 0;
     Real max_penetration_m = 0;
     std::uint64_t warp_moved = 0;  ///< Particles the warp limit moved.
+    std::uint64_t weft_moved = 0;  ///< Springs the weft limit corrected.
     bool finite = true;
 };
 
@@ -73,6 +74,7 @@ struct GarmentSolver {
     std::vector<SpringSet> springs;          ///< The springs the model solves, in order.
     std::vector<Tethers> tethers;            ///< Long-range attachments from the pins, per line band.
     std::vector<std::uint32_t> below;        ///< Per particle: the particle below it on its line (itself in the last row).
+    VectorX weft_rest_right;                 ///< Per particle: rest length of the weft spring to the next line.
     VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
                                              ///< on its line (0 in the first row).
     Real drag_step_s = 0;                    ///< Largest stable step of the explicit drag.
@@ -94,6 +96,7 @@ struct GarmentSolver {
     Matrix3X push;                           ///< Per particle: the collision rounds' push-outs this substep.
     std::vector<std::uint64_t> contacts;     ///< Per particle: ellipsoids it touched in this substep's rounds.
     Matrix3X warp_moves;                     ///< Per particle: the warp limit's move this substep.
+    Matrix3X weft_moves;                     ///< Per particle: the weft limit's move this substep.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.
 };
 

@@ -17,12 +17,12 @@
 
 namespace drape {
 
-// The warp limit holds the warp within this share of Provot's limit, leaving the rest of
-// the limit to what the last collision does after it. Lower, it acts on a garment at rest
-// (the rounds leave a line hanging a few percent long over the hips) and dynamic
-// follow-the-leader's velocity correction then keeps it moving: at 2 % of stretch the skirt
-// on a still body kept 1 cm/s, at 5 % it comes to rest (docs/cloth.md).
-constexpr Real warp_limit_share = Real(0.5);
+// The warp and weft limits hold the springs within this share of Provot's limit, leaving
+// the rest of the limit to what the last collision does after them. Lower, the warp limit
+// acts on a garment at rest (the rounds leave a line hanging a few percent long over the
+// hips) and dynamic follow-the-leader's velocity correction then keeps it moving: at 2 % of
+// stretch the skirt on a still body kept 1 cm/s, at 5 % it comes to rest (docs/cloth.md).
+constexpr Real limit_share = Real(0.5);
 
 // Dynamic follow-the-leader's damping s_damping (Müller et al. 2012): the share of a
 // follower's warp-limit move that its leader's velocity gives back.
@@ -148,11 +148,19 @@ void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSub
 
 void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep&) {
     prepare_solver(g, s);
-    const Real stretch = warp_limit_share * g.config.material.strain_limit;
+    const Real stretch = limit_share * g.config.material.strain_limit;
     for_each_part(s.parts.count, [&](std::size_t k) {
         const auto [first_line, end_line] = s.parts.lines[k];
         s.part_counters[k].warp_moved =
             limit_warp_lines(*g.fabric, s.warp_rest_above, s.inv_mass, stretch, g.state.x, s.warp_moves, first_line, end_line);
+    });
+    // Then the weft, row by row: a row crosses every band, so the rows are shared out instead.
+    const std::size_t parts = s.parts.count;
+    const std::uint32_t rows = g.fabric->particles_per_line;
+    for_each_part(parts, [&](std::size_t k) {
+        const auto first_row = static_cast<std::uint32_t>(rows * k / parts), end_row = static_cast<std::uint32_t>(rows * (k + 1) / parts);
+        s.part_counters[k].weft_moved =
+            limit_weft_rows(*g.fabric, s.weft_rest_right, s.inv_mass, stretch, g.state.x, s.weft_moves, first_row, end_row);
     });
 }
 
@@ -207,18 +215,21 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Ei
     }
 }
 
-// The warp limit moved particles after the last collision round (on the sample scene's walk
-// 153 of 837 per substep, 61 of them by a millimetre or more): in band `part`, each block of
-// 64 particles holding one is collided again, in the garment's collision mode (the band's
-// lists brought up to date first), positions only; the last round's contacts are kept.
-void collide_warp_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCounters& c) {
+// The warp and weft limits moved particles after the last collision round (on the sample
+// scene's walk the warp limit 153 of 837 per substep, 61 of them by a millimetre or more):
+// in band `part`, each block of 64 particles holding one is collided again, in the
+// garment's collision mode (the band's lists brought up to date first), positions only; the
+// last round's contacts are kept.
+void collide_limit_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCounters& c) {
     constexpr Eigen::Index block = 64;
     bool lists_current = false;
     std::array<std::uint64_t, block> before{};
     for (const auto [first, n] : s.parts.runs[part]) {
         for (Eigen::Index begin = first; begin < n; begin += block) {
             const Eigen::Index end = std::min(begin + block, n);
-            if (s.warp_moves.middleCols(begin, end - begin).cwiseAbs().maxCoeff() == 0) continue;
+            if (s.warp_moves.middleCols(begin, end - begin).cwiseAbs().maxCoeff() == 0 &&
+                s.weft_moves.middleCols(begin, end - begin).cwiseAbs().maxCoeff() == 0)
+                continue;
             if (!lists_current && g.config.collision == CollisionMode::candidate_lists) {
                 update_candidate_part(g, s, part, c);
                 lists_current = true;
@@ -247,12 +258,13 @@ bool all_finite(const M& m) {
 
 void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
-    // The lists are sized on this thread first when the warp limit moved anything.
-    const bool moved = std::any_of(s.part_counters.begin(), s.part_counters.end(), [](const PartCounters& c) { return c.warp_moved > 0; });
+    // The lists are sized on this thread first when a limit moved anything.
+    const bool moved = std::any_of(s.part_counters.begin(), s.part_counters.end(),
+                                   [](const PartCounters& c) { return c.warp_moved > 0 || c.weft_moved > 0; });
     if (moved && g.config.collision == CollisionMode::candidate_lists) prepare_candidate_lists(g, s);
     for_each_part(s.parts.count, [&](std::size_t k) {
         PartCounters& c = s.part_counters[k] = PartCounters{};
-        if (moved) collide_warp_moves(g, s, k, c);
+        if (moved) collide_limit_moves(g, s, k, c);
         for (const auto [first, end] : s.parts.runs[k]) {
             update_velocities(g, s, sub, first, end);
             c.finite = c.finite && all_finite(g.state.x.middleCols(first, end - first)) &&

@@ -16,7 +16,8 @@
 //                             (collides_after): candidate lists brought up to date, then
 //                             every particle out of the ellipsoids (§5), positions only
 //     finish_constraints      cloth_constraint: Provot's limit along every warp line from
-//                             the pins down (constraints.hpp limit_warp_lines)
+//                             the pins down, then along every weft row (constraints.hpp
+//                             limit_warp_lines, limit_weft_rows)
 //     finish_collision        cloth_collision: a last collision round, then the velocities of
 //                             the free particles from the substep's move (less the push-outs
 //                             and the warp limit's moves; at contacts no approach, friction),
@@ -62,11 +63,12 @@ void constrain_round(Garment& garment, GarmentSolver& solver, const ClothSubstep
 void collide_round(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep,
                    int round);
 
-/// After the rounds: Provot's limit along every warp line, one-sided from the pins down
-/// (constraints.hpp limit_warp_lines); its moves are kept for the velocities.
+/// After the rounds: Provot's limit along every warp line, one-sided from the pins down,
+/// then along every weft row (constraints.hpp limit_warp_lines, limit_weft_rows); their
+/// moves are kept.
 void finish_constraints(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
-/// After finish_constraints: a last collision round (the warp limit moved particles), then
+/// After finish_constraints: a last collision round (the limits moved particles), then
 /// the velocities of the free particles from their move over the substep: the warp limit's
 /// move of the particle below on the line given back (dynamic follow-the-leader), the
 /// push-outs left out; where a particle touched an ellipsoid, no velocity toward it relative

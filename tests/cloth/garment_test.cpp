@@ -12,6 +12,7 @@
 #include "systems/cloth/body.hpp"
 #include "systems/cloth_systems.hpp"
 #include "systems/cloth/collision.hpp"
+#include "systems/cloth/constraints.hpp"
 #include "systems/cloth/garment_builder.hpp"
 #include "systems/cloth/garment_config.hpp"
 #include "systems/cloth/garment_step.hpp"
@@ -411,6 +412,44 @@ TEST(Parts, BandsCoverEveryParticleOnceAndEverySpringIsInItsBandOrJoinsTwo) {
         }
     EXPECT_EQ(carried, g.fabric->weft_particle.size());
     EXPECT_LT(parts.edge_weft_entries.size(), g.fabric->weft_particle.size() / 10);
+}
+
+TEST(WeftLimit, AnOverLongRunOfARowIsBroughtWithinItsBoundInOneCallSharedByMass) {
+    RectangleParams r;
+    r.warp_lines = 16;
+    r.particles_per_line = 8;
+    auto made = make_rectangle(r);
+    ASSERT_TRUE(made) << made.error().message;
+    Garment g = std::move(*made);
+    const Fabric& f = *g.fabric;
+    const VectorX rest = weft_rest_right(f);
+    const std::uint32_t m = f.particles_per_line;
+    const auto at = [&](std::uint32_t line, std::uint32_t row) { return f.grid[line * m + row]; };
+    // Row 5: line 8 pushed 1.5 spacings out of the sheet (as a collision push does), so its
+    // two weft springs are 80 % over their rest length.
+    g.state.x(2, at(8, 5)) += Real(1.5) / 15;
+    const Matrix3X before = g.state.x;
+    Matrix3X moves = Matrix3X::Constant(3, g.state.x.cols(), 1);
+    constexpr Real stretch = Real(0.05);
+    const std::uint64_t corrected = limit_weft_rows(f, rest, g.state.inv_mass, stretch, g.state.x, moves, 0, m);
+    EXPECT_GT(corrected, 1u);  // a run, not one spring
+    Vec3 momentum = Vec3::Zero();
+    for (std::uint32_t row = 0; row < m; ++row)
+        for (std::uint32_t line = 0; line + 1 < f.warp_lines; ++line) {
+            const std::uint32_t a = at(line, row), b = at(line + 1, row);
+            EXPECT_LE((g.state.x.col(b) - g.state.x.col(a)).norm(), (1 + stretch + weft_limit_tolerance) * rest[a])
+                << "row " << row << " line " << line;
+            EXPECT_LT((g.state.x.col(a) - before.col(a) - moves.col(a)).norm(), 1e-6f);
+            if (row != 5) {
+                EXPECT_TRUE(moves.col(a).isZero()) << "row " << row << " was within its bound";
+            }
+            if (row == 5 && g.state.inv_mass[a] > 0) momentum += (g.state.x.col(a) - before.col(a)) / g.state.inv_mass[a];
+        }
+    // The pinned first row stays; the run's corrections are equal and opposite.
+    for (std::uint32_t line = 0; line < f.warp_lines; ++line) EXPECT_EQ(g.state.x.col(at(line, 0)), before.col(at(line, 0)));
+    const std::uint32_t last = at(f.warp_lines - 1, 5);
+    momentum += (g.state.x.col(last) - before.col(last)) / g.state.inv_mass[last];
+    EXPECT_LT(momentum.norm(), 1e-5f);
 }
 
 }  // namespace
