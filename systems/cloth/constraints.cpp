@@ -246,14 +246,23 @@ std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const 
     std::vector<std::uint32_t> p(n);
     std::vector<Vec3> dir(springs);
     std::vector<Real> excess(springs), diag(springs), upper(springs), dl(springs), sweep(springs);
+    std::vector<char> dirty(springs);
     for (std::uint32_t row = first_row; row < end_row; ++row) {
         for (std::uint32_t line = 0; line < n; ++line) {
             p[line] = f.grid[line * m + row];
             moves.col(p[line]).setZero();
         }
+        std::fill(dirty.begin(), dirty.end(), char(1));
         for (int pass = 0; pass < weft_limit_passes; ++pass) {
             bool over = false;
             for (std::uint32_t i = 0; i < springs; ++i) {
+                // After the first pass only the springs of and next to a corrected run can
+                // have changed: the others stay within their bound.
+                if (!dirty[i]) {
+                    excess[i] = -1;
+                    continue;
+                }
+                dirty[i] = 0;
                 const std::uint32_t a = p[i], b = p[i + 1 < n ? i + 1 : 0];
                 const Real bound = scale * rest_right[a];
                 const Real length_sq = (x.col(b) - x.col(a)).squaredNorm();
@@ -303,6 +312,7 @@ std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const 
                     x.col(b) += w[b] * step;
                     moves.col(b) += w[b] * step;
                 }
+                for (std::uint32_t j = 0; j < len + 2; ++j) dirty[(start + k + j + springs - 1) % springs] = 1;
                 corrected += len;
                 k += len;
             }
