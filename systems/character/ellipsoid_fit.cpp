@@ -263,6 +263,7 @@ Result<void> validate(const FitOptions& o) {
     if (!(o.sample_spacing > 0 && o.sample_spacing <= 0.5)) return fail("fit.sample_spacing: must be in (0, 0.5]");
     if (!(o.min_radius_m > 0 && std::isfinite(o.min_radius_m))) return fail("fit.min_radius_m: must be > 0");
     if (o.max_ellipsoids < 0) return fail("fit.max_ellipsoids: must be >= 0 (0: no limit)");
+    if (!(o.leg_reach_m <= 1)) return fail("fit.leg_reach_m: must be <= 1 m (< 0: no limit)");
     return {};
 }
 
@@ -447,7 +448,9 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
     for (std::size_t p = 0; p < bone_parts; ++p) {
         const int partner = skeleton.find(mirror_name(skeleton.bone_names[static_cast<std::size_t>(bone_of_part[p])]));
         if (partner >= 0 && partner != bone_of_part[p]) part_info[p].mirror = part_of_bone[static_cast<std::size_t>(partner)];
-        part_info[p].may_split = !limb(region_of(static_cast<std::size_t>(bone_of_part[p])));
+        const BodyRegion region = region_of(static_cast<std::size_t>(bone_of_part[p]));
+        part_info[p].may_split = !limb(region);
+        part_info[p].limited_reach = options.leg_reach_m >= 0 && (region == BodyRegion::upper_leg || region == BodyRegion::lower_leg);
     }
 
     std::vector<Affine3> global, skinning;
@@ -464,6 +467,7 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
     settings.cover_margin_m = 0.5 * options.tolerance_m;
     settings.bulge_limit_m = options.bulge_limit_m;
     settings.min_radius_m = options.min_radius_m;
+    settings.reach_m = std::max(0.0, options.leg_reach_m);
     settings.max_pieces = options.max_ellipsoids > 0 ? options.max_ellipsoids : 1 << 20;
     const SkinSurface skin(positions, normals, mesh.indices);
     std::vector<fitting::Piece> pieces = fitting::fit_pieces(skin, samples, part_of, part_info, settings);

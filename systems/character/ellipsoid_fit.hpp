@@ -17,14 +17,12 @@
 // the knee and the hip where the cloth's hem catches. Shapes are stored in the rigid
 // frame of their bone at the rest pose.
 //
-// The legs: by default (`hug_legs` false) each leg bone keeps the ellipsoid that bounds
-// its vertices (principal axes, 97 % of them inside), which stands out of the skin by
-// several centimetres, most between the thighs. Fitted tight, the legs leave a gap
-// between them in which the cloth solver traps the skirt's hem as the legs scissor: on
-// the sample scene's walk the structural strain after the frame rises from 39 % to
-// 230 % at most (p99 12 % to 16 %), on Male_Casual's skirt from 42 % (p99 16 %) to 1900 %
-// (p99 87 %). The bounded legs are what keeps the coverage target's p95 bulge above
-// 2 cm on the humanoids; `hug_legs` is there for the day the cloth handles the gap.
+// The legs: each leg bone gets one ellipsoid fitted tight, which may not reach more than
+// a few centimetres past its own skin along the leg (ellipsoid_solver.hpp, "reach"): a
+// shin's tip hidden inside the thigh at the rest pose would stand out behind the bent
+// knee. With `hug_legs` false each leg bone keeps instead the ellipsoid that bounds its
+// vertices (principal axes, 97 % of them inside), which stands out of the skin by several
+// centimetres, most between the thighs, and misses the 2 cm bulge target.
 //
 // Measures (measure_coverage):
 //  - coverage: the share of skin vertices inside some ellipsoid or within `tolerance_m` of
@@ -66,7 +64,8 @@ struct FitOptions {
     double sample_spacing = 0.016;         ///< Skin samples inside large faces at most this share of the height apart.
     double min_radius_m = 0.01;            ///< No axis thinner than this.
     int max_ellipsoids = 32;               ///< Budget (the paper's avatar has 15, a garment takes 64); 0 = no limit.
-    bool hug_legs = false;                 ///< Fit the legs tight too (see the header comment); else they keep their bounding ellipsoids.
+    double leg_reach_m = 0.05;             ///< A hugged leg's ellipsoid may pass its own skin along the leg by this much (< 0: no limit).
+    bool hug_legs = true;                  ///< Fit the legs tight too (see the header comment); else they keep their bounding ellipsoids.
 };
 
 /// Checks the options; the error names the field.

@@ -261,7 +261,8 @@ struct Solver {
     void residuals(std::size_t k, const Ellipsoid& e, const std::vector<std::uint32_t>& near, const std::vector<char>& cover,
                    const std::vector<double>& scale, Eigen::VectorXd& r) const {
         const std::size_t m = sphere.size();
-        r.resize(static_cast<Eigen::Index>(near.size() + 2 * m));
+        const Piece& piece = pieces[k];
+        r.resize(static_cast<Eigen::Index>(near.size() + (piece.limited_reach ? 3 : 2) * m));
         for (std::size_t i = 0; i < near.size(); ++i) {
             const SkinSample& s = samples[near[i]];
             if (!cover[i]) {
@@ -285,6 +286,12 @@ struct Solver {
             }
             r[Eigen::Index(near.size() + 2 * i)] = loose;
             r[Eigen::Index(near.size() + 2 * i + 1)] = tight;
+            if (piece.limited_reach) {
+                const double along = piece.reach_axis.dot(x);
+                const double past = std::max(along - piece.reach_hi, piece.reach_lo - along) - settings.reach_m;
+                const double area = unit_area * sphere[i].cwiseQuotient(e.radii).norm();
+                r[Eigen::Index(near.size() + 2 * m + i)] = std::sqrt(settings.bulge_weight * area / sample_area_m2) * soft_excess(past, 0, settings.huber_m);
+            }
         }
     }
 
@@ -598,6 +605,19 @@ std::vector<Piece> fit_pieces(const SkinSurface& skin, const std::vector<SkinSam
         piece.part = p;
         piece.samples = own;
         piece.shape = initial_shape(samples, own, settings.min_radius_m);
+        if (static_cast<std::size_t>(p) < part_info.size() && part_info[static_cast<std::size_t>(p)].limited_reach) {
+            piece.limited_reach = true;
+            Eigen::Index longest = 0;
+            piece.shape.radii.maxCoeff(&longest);
+            piece.reach_axis = piece.shape.axes.col(longest);
+            piece.reach_lo = std::numeric_limits<double>::infinity();
+            piece.reach_hi = -piece.reach_lo;
+            for (std::uint32_t s : own) {
+                const double along = piece.reach_axis.dot(samples[s].position);
+                piece.reach_lo = std::min(piece.reach_lo, along);
+                piece.reach_hi = std::max(piece.reach_hi, along);
+            }
+        }
         for (std::uint32_t s : own) solver.piece_of[s] = static_cast<int>(solver.pieces.size());
         solver.pieces.push_back(std::move(piece));
     }

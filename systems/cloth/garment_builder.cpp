@@ -107,6 +107,12 @@ Real ray_exit(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     return (-b + std::sqrt(disc)) / (2 * a);
 }
 
+// How far the ellipsoid reaches from o in direction d (|d| = 1): its support, d . (c - o)
+// + |diag(r) R^T d|.
+Real support_distance(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
+    return d.dot(f.center - o) + f.radii_m.cwiseProduct(f.rotation.transpose() * d).norm();
+}
+
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
                     std::span<const EllipsoidFrame> frames, std::uint32_t p, const Vec3& x) {
@@ -306,6 +312,10 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
         const Vec3 d(std::sin(theta), 0, std::cos(theta));
         Real r = -1;
         for (std::size_t e : outline) r = std::max(r, ray_exit(frames[e], origin, d));
+        // Between two legs hugged apart (a ring below the crotch) a ray may pass every
+        // collider: the line then stands on the body's hull, as far as the colliders reach.
+        if (r <= 0)
+            for (std::size_t e : outline) r = std::max(r, support_distance(frames[e], origin, d));
         if (r <= 0) return fail(p + ": the body outline at the ring height does not surround the axis");
         r += s.ease_m;
         // Down the cone, but never closer to the axis than the body below the ring (hips,
