@@ -284,15 +284,16 @@ TEST(DefaultAvatar, ImportsLikeAnyCharacter) {
 }
 
 // The fitted ellipsoids: within a garment's 64 colliders and the fit's budget, one
-// ellipsoid per leg bone, a pelvis. The default fit hugs the body to the target: 99 % of
-// the skin within 1 cm of the ellipsoids and 95 % of their surface that stands out of the
-// skin no more than 2 cm out. With the legs' bounding ellipsoids instead
-// (FitOptions::hug_legs false) the target is missed between the thighs, and the bound below
-// guards the rest of the fit (a trunk or arm piece floating off the body would break it).
-constexpr double bounding_legs_p95_bulge_bound_m = 0.08;
+// ellipsoid per leg bone, a pelvis. Fitted with the legs tight too (FitOptions::hug_legs),
+// they hug the body to the target: 99 % of the skin within 1 cm of them and 95 % of their
+// surface that stands out of the skin no more than 2 cm out. The default fit keeps the legs'
+// bounding ellipsoids (tight legs leave skin showing through the cloth: docs/cloth.md,
+// "Known limits"): there the target is missed and the bound below guards the rest of the
+// fit (a trunk or arm piece floating off the body would break it).
+constexpr double default_fit_p95_bulge_bound_m = 0.08;
 
 void expect_fitted_ellipsoids(const CharacterAsset& c, const std::string& what, bool hug_legs) {
-    SCOPED_TRACE(what + (hug_legs ? ", default fit" : ", bounding legs"));
+    SCOPED_TRACE(what + (hug_legs ? ", legs hugged" : ", default fit"));
     FitOptions options;
     options.hug_legs = hug_legs;
     const auto body = fit_character_body(c, options);
@@ -307,7 +308,7 @@ void expect_fitted_ellipsoids(const CharacterAsset& c, const std::string& what, 
     EXPECT_TRUE(body->landmarks) << body->landmarks_error;
     const CoverageReport coverage = rest_pose_coverage(c, *body);
     EXPECT_GE(coverage.coverage, 0.99) << "largest gap " << coverage.max_gap_m << " m";
-    EXPECT_LE(coverage.p95_bulge_m, hug_legs ? 0.02 : bounding_legs_p95_bulge_bound_m) << "max bulge " << coverage.max_bulge_m << " m";
+    EXPECT_LE(coverage.p95_bulge_m, hug_legs ? 0.02 : default_fit_p95_bulge_bound_m) << "max bulge " << coverage.max_bulge_m << " m";
 }
 
 void expect_hugging_ellipsoids(const CharacterAsset& c, const std::string& what) {
@@ -347,7 +348,7 @@ std::pair<double, double> walk_bulge(const CharacterAsset& c, const FitOptions& 
     return {p95, max};
 }
 
-// The legs' ellipsoids stay on the legs as the knees bend: a shin's piece may not grow a
+// Hugged legs' ellipsoids stay on the legs as the knees bend: a shin's piece may not grow a
 // tip up inside the thigh, hidden there at the rest pose, which would stand out behind
 // the bent knee (FitOptions::leg_reach_m). Over 8 frames of the walk the limited fit
 // stands out 1.7 cm (95th percentile) and 9.6 cm at most (where a joint bends); with no
@@ -355,7 +356,9 @@ std::pair<double, double> walk_bulge(const CharacterAsset& c, const FitOptions& 
 TEST(DefaultAvatar, FittedLegsKeepHuggingThroughTheWalk) {
     const auto imported = import_character(committed_avatar);
     ASSERT_TRUE(imported) << imported.error().message;
-    const auto [p95, max] = walk_bulge(**imported, FitOptions{});
+    FitOptions options;
+    options.hug_legs = true;
+    const auto [p95, max] = walk_bulge(**imported, options);
     EXPECT_LE(p95, 0.025);
     EXPECT_LE(max, 0.12);
 }
