@@ -450,7 +450,10 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
         if (partner >= 0 && partner != bone_of_part[p]) part_info[p].mirror = part_of_bone[static_cast<std::size_t>(partner)];
         const BodyRegion region = region_of(static_cast<std::size_t>(bone_of_part[p]));
         part_info[p].may_split = !limb(region);
-        part_info[p].limited_reach = options.leg_reach_m >= 0 && (region == BodyRegion::upper_leg || region == BodyRegion::lower_leg);
+        // Only hugged legs keep their fitted ellipsoid; the reach term on legs that are
+        // replaced by their bounding ellipsoids below would still move their neighbours.
+        part_info[p].limited_reach = options.hug_legs && options.leg_reach_m >= 0 &&
+                                     (region == BodyRegion::upper_leg || region == BodyRegion::lower_leg);
     }
 
     std::vector<Affine3> global, skinning;

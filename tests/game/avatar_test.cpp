@@ -363,6 +363,33 @@ TEST(DefaultAvatar, FittedLegsKeepHuggingThroughTheWalk) {
     EXPECT_LE(max, 0.12);
 }
 
+// The leg reach shapes hugged legs only: with the legs' bounding ellipsoids (the default)
+// the fit is the same whatever the reach, since a reach term on the legs fitted jointly
+// with the trunk would still move the trunk's pieces.
+TEST(DefaultAvatar, LegReachLeavesTheDefaultFitAlone) {
+    const auto imported = import_character(committed_avatar);
+    ASSERT_TRUE(imported) << imported.error().message;
+    FitOptions reach, none;
+    none.leg_reach_m = -1;
+    ASSERT_FALSE(reach.hug_legs);
+    const auto a = fit_character_body(**imported, reach), b = fit_character_body(**imported, none);
+    ASSERT_TRUE(a && b);
+    ASSERT_EQ(a->ellipsoids.size(), b->ellipsoids.size());
+    for (std::size_t i = 0; i < a->ellipsoids.size(); ++i) {
+        EXPECT_EQ(a->ellipsoids[i].bone, b->ellipsoids[i].bone) << i;
+        EXPECT_TRUE(a->ellipsoids[i].center.isApprox(b->ellipsoids[i].center, 1e-6f)) << i;
+        EXPECT_TRUE(a->ellipsoids[i].radii_m.isApprox(b->ellipsoids[i].radii_m, 1e-6f)) << i;
+    }
+    // And hugged legs do feel it.
+    reach.hug_legs = none.hug_legs = true;
+    const auto c = fit_character_body(**imported, reach), d = fit_character_body(**imported, none);
+    ASSERT_TRUE(c && d);
+    bool differ = c->ellipsoids.size() != d->ellipsoids.size();
+    for (std::size_t i = 0; !differ && i < c->ellipsoids.size(); ++i)
+        differ = !c->ellipsoids[i].radii_m.isApprox(d->ellipsoids[i].radii_m, 1e-4f);
+    EXPECT_TRUE(differ);
+}
+
 // The avatar reshaped by a map of model space (positions, joints and the clips' bone
 // offsets move with it; normals are recomputed), to make builds the generator's options
 // (height only) do not give.
