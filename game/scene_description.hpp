@@ -97,6 +97,8 @@ struct SolverDescription {
     int max_steps_per_frame = 4;         ///< Time beyond this many steps per frame is dropped.
     double time_scale = 1;               ///< Simulated seconds per wall-clock second.
     int substeps = 0;                    ///< Simulation substeps per step; 0 = the cloth's stability rule.
+    double max_surface_travel_m = 0.04;  ///< Automatic substeps: how far a collider's surface may move per substep.
+    int max_substeps = 8;                ///< Automatic substeps: at most this many per step.
     double max_frame_dt_s = 0.25;        ///< Longer frames (hitches) are clamped to this first.
     double teleport_threshold_m = 1.0;   ///< A body moving further in one step resets its garments.
     int threads = 0;                     ///< Worker threads; 0 = all cores.

@@ -525,6 +525,9 @@ SolverDescription read_solver(const Reader& r, const Json& j) {
         else
             r.fail_at(f.path("substeps"), cat("must be \"auto\" or an integer in [1, 1000], got ", shown(*v)));
     }
+    if (const Json* v = f.get("max_surface_travel_m"))
+        s.max_surface_travel_m = read_real(r, f.path("max_surface_travel_m"), *v, 0, 1, Bound::open);
+    if (const Json* v = f.get("max_substeps")) s.max_substeps = read_int(r, f.path("max_substeps"), *v, 1, 1000);
     if (const Json* v = f.get("max_frame_dt_s")) s.max_frame_dt_s = read_real(r, f.path("max_frame_dt_s"), *v, 0, 10, Bound::open);
     if (const Json* v = f.get("teleport_threshold_m"))
         s.teleport_threshold_m = read_real(r, f.path("teleport_threshold_m"), *v, 0, max_coordinate_m, Bound::open);
@@ -705,6 +708,8 @@ std::string to_json(const SceneDescription& scene) {
                    {"max_steps_per_frame", s.max_steps_per_frame},
                    {"time_scale", s.time_scale},
                    {"substeps", s.substeps == 0 ? OrderedJson("auto") : OrderedJson(s.substeps)},
+                   {"max_surface_travel_m", s.max_surface_travel_m},
+                   {"max_substeps", s.max_substeps},
                    {"max_frame_dt_s", s.max_frame_dt_s},
                    {"teleport_threshold_m", s.teleport_threshold_m},
                    {"threads", s.threads}};

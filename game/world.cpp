@@ -107,6 +107,8 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
     world.scheduler.add(make_teleport_guard_system(scene.solver.teleport_threshold_m, world.teleports));
     ClothSolverSettings cloth;
     cloth.fixed_substeps = scene.solver.substeps;
+    cloth.max_surface_travel_m = static_cast<Real>(scene.solver.max_surface_travel_m);
+    cloth.max_substeps = scene.solver.max_substeps;
     add_cloth_systems(world.scheduler, cloth);
     // The garment builders fit around placed colliders (overrides included): one pass of
     // the skinning phase (colliders) places them before the first step.

@@ -60,7 +60,7 @@ constexpr const char* valid_scene = R"({
     {"character": 1, "bone": "Head", "remove": true}
   ],
   "solver": {"fixed_dt_s": 0.008, "max_steps_per_frame": 6, "time_scale": 0.5, "substeps": 3,
-             "max_frame_dt_s": 0.1, "teleport_threshold_m": 0.5, "threads": 2},
+             "max_surface_travel_m": 0.01, "max_substeps": 12, "max_frame_dt_s": 0.1, "teleport_threshold_m": 0.5, "threads": 2},
   "camera": {"follow": false, "target_m": [0, 1, 0], "distance_m": 4, "yaw_deg": 20,
              "pitch_deg": 10, "fov_deg": 45}
 })";
@@ -89,6 +89,8 @@ TEST_F(SceneFileTest, ValidFileIsReadCompletely) {
     EXPECT_TRUE(scene->colliders[1].remove);
     EXPECT_EQ(scene->solver.substeps, 3);
     EXPECT_EQ(scene->solver.threads, 2);
+    EXPECT_DOUBLE_EQ(scene->solver.max_surface_travel_m, 0.01);
+    EXPECT_EQ(scene->solver.max_substeps, 12);
     EXPECT_DOUBLE_EQ(scene->solver.teleport_threshold_m, 0.5);
     EXPECT_FALSE(scene->camera.follow);
     EXPECT_FLOAT_EQ(scene->camera.fov_deg, 45);
@@ -156,6 +158,10 @@ TEST_F(SceneFileTest, WrongTypesAreNamed) {
               "scene.json:1:68: garments[0].type: must be one of \"skirt\", \"dress\", got \"shirt\"");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"substeps": 2.5}})"),
               "scene.json:1:69: solver.substeps: must be \"auto\" or an integer in [1, 1000], got 2.5");
+    EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"max_surface_travel_m": 0}})"),
+              "scene.json:1:81: solver.max_surface_travel_m: must be a number in (0, 1], got 0");
+    EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"max_substeps": 0}})"),
+              "scene.json:1:73: solver.max_substeps: must be an integer in [1, 1000], got 0");
     EXPECT_EQ(error("[1, 2]"), "scene.json:1:1: must be an object ({...}), got array [1,2]");
 }
 

@@ -51,6 +51,8 @@ public:
         garment = m_world->registry.get<Garment>(e);
         solver = m_world->registry.get<GarmentSolver>(e);
         m_settings.fixed_substeps = scene.solver.substeps;
+        m_settings.max_surface_travel_m = static_cast<Real>(scene.solver.max_surface_travel_m);
+        m_settings.max_substeps = scene.solver.max_substeps;
         if (!keep_in_world) {
             m_world->registry.destroy(e);
             m_world->garments.clear();

@@ -17,6 +17,7 @@
 #include "game/world.hpp"
 #include "game/scene_garment_parameters.hpp"
 #include "systems/cloth/garment_builder.hpp"
+#include "systems/cloth/substeps.hpp"
 
 namespace drape {
 namespace {
@@ -154,6 +155,34 @@ TEST(TeleportGuard, ThresholdIsASolverSetting) {
     world->registry.get<Transform>(world->characters[0]).position += Vec3(5, 0, 0);
     ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
     EXPECT_EQ(world->teleports->teleports, 0u);
+}
+
+// The motion term of the automatic substeps comes from the scene: a shorter surface travel
+// per substep takes more substeps on the same walk, up to the scene's cap; the defaults are
+// the cloth's own.
+TEST(AutomaticSubsteps, MotionTermAndCapAreSolverSettings) {
+    EXPECT_FLOAT_EQ(static_cast<Real>(SolverDescription{}.max_surface_travel_m), ClothSolverSettings{}.max_surface_travel_m);
+    EXPECT_EQ(SolverDescription{}.max_substeps, ClothSolverSettings{}.max_substeps);
+    const auto most_substeps = [](double travel_m, int cap) {
+        SceneDescription scene = sample();
+        scene.solver.max_surface_travel_m = travel_m;
+        scene.solver.max_substeps = cap;
+        auto world = build_world(scene, {});
+        EXPECT_TRUE(world) << world.error().message;
+        if (!world) return 0;
+        int most = 0;
+        for (int frame = 0; frame < 60; ++frame) {
+            EXPECT_TRUE(step_world(*world, 1.0 / 60.0));
+            const Garment& g = world->registry.get<Garment>(world->garments.at(0));
+            EXPECT_LE(g.counters.substeps, cap);
+            most = std::max(most, g.counters.substeps_motion);
+        }
+        return most;
+    };
+    const int coarse = most_substeps(0.04, 8);
+    const int fine = most_substeps(0.005, 64);
+    EXPECT_GT(fine, 2 * coarse) << "an eighth of the travel per substep";
+    EXPECT_EQ(most_substeps(0.005, 3), 3) << "the cap holds";
 }
 
 TEST(ExplicitReset, PutsTheGarmentBackAroundTheBody) {
