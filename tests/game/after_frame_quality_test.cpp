@@ -39,6 +39,7 @@ TEST(AfterFrameQuality, SimplifiedSkirtOnTheWalk) {
     const GarmentStats g = walk(GarmentType::skirt, ClothModel::simplified, 600);
     expect_clean(g);
     EXPECT_LE(g.strain_p99, 0.10);
+    EXPECT_LE(g.strain_max, 0.15);
 }
 
 TEST(AfterFrameQuality, ClassicSkirtOnTheWalk) {

@@ -2,6 +2,9 @@
 // generator's output, a plausible body and walk, and it loads through the same import path
 // as any other character with fitted ellipsoids that cover it.
 #include "game/avatar_generator.hpp"
+#include "game/sample_scene.hpp"
+#include "game/stats.hpp"
+#include "game/world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -426,25 +429,57 @@ Result<std::shared_ptr<const CharacterAsset>> import_model(const AvatarModel& m,
     return std::shared_ptr<const CharacterAsset>(std::move(*c));
 }
 
-TEST(AvatarBuilds, FittedEllipsoidsHugShortWideAndLongLeggedBodies) {
+// Builds the generator's options (height only) do not give: short, wide, long-legged.
+std::vector<std::pair<std::string, AvatarModel>> unusual_builds() {
     const AvatarModel& base = avatar();
     const int hip = base.find_bone("LeftUpLeg");
-    ASSERT_GE(hip, 0);
+    EXPECT_GE(hip, 0);
+    if (hip < 0) return {};
     const double hip_y = base.bones[std::size_t(hip)].joint_m.y();
     AvatarOptions short_options;
     short_options.height_m = 1.2;
-    const std::pair<std::string, AvatarModel> builds[] = {
-        {"short", make_default_avatar(short_options)},
-        {"wide", reshaped(base, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.35 * p.x(), p.y(), 1.25 * p.z()); })},
-        // Legs a quarter longer: below the hip joints height stretches, above it shifts up.
-        {"long_legged", reshaped(base, [&](const Eigen::Vector3d& p) {
-             return Eigen::Vector3d(p.x(), p.y() < hip_y ? 1.25 * p.y() : p.y() + 0.25 * hip_y, p.z());
-         })},
-    };
-    for (const auto& [name, model] : builds) {
+    std::vector<std::pair<std::string, AvatarModel>> builds;
+    builds.emplace_back("short", make_default_avatar(short_options));
+    builds.emplace_back("wide", reshaped(base, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.35 * p.x(), p.y(), 1.25 * p.z()); }));
+    // Legs a quarter longer: below the hip joints height stretches, above it shifts up.
+    builds.emplace_back("long_legged", reshaped(base, [&](const Eigen::Vector3d& p) {
+        return Eigen::Vector3d(p.x(), p.y() < hip_y ? 1.25 * p.y() : p.y() + 0.25 * hip_y, p.z());
+    }));
+    return builds;
+}
+
+TEST(AvatarBuilds, FittedEllipsoidsHugShortWideAndLongLeggedBodies) {
+    for (const auto& [name, model] : unusual_builds()) {
         const auto c = import_model(model, name);
         ASSERT_TRUE(c) << name << ": " << c.error().message;
         expect_hugging_ellipsoids(**c, name);
+    }
+}
+
+// The skirt on the wide and the long-legged build, 600 frames of their walk, after every
+// frame: the contract asked of characters the team did not tune for (strain p99 <= 10 %,
+// max <= 20 %, nothing left inside after the frame beyond 2 mm, pins outside). Measured:
+// max 7.7 % (wide) and 7.5 % (long-legged). The short build misses it (43 %, its hem
+// caught round a shin) and the dress misses on all three (docs/cloth.md, "Known limits").
+TEST(AvatarBuilds, SkirtHoldsTheContractOnTheWideAndLongLeggedBuilds) {
+    for (const auto& [name, model] : unusual_builds()) {
+        if (name == "short") continue;
+        SCOPED_TRACE(name);
+        const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / ("avatar_build_skirt_" + name + ".glb");
+        ASSERT_TRUE(write_avatar(model, path));
+        SceneDescription scene = sample_scene();
+        scene.characters.at(0).file = path;
+        auto world = build_world(scene, {});
+        ASSERT_TRUE(world) << world.error().message;
+        for (int frame = 0; frame < 600; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+        const GarmentStats g = run_stats(*world).garments.at(0);
+        EXPECT_LE(g.strain_p99, 0.10);
+        EXPECT_LE(g.strain_max, 0.20);
+        EXPECT_LE(g.penetration_after_frame_m, 2e-3);
+        EXPECT_LE(g.pins_inside_m, 5e-3);
+        EXPECT_EQ(g.nonfinite, 0u);
+        EXPECT_EQ(g.resets, 0u);
+        EXPECT_GT(g.penetration_before_response_m, 1e-3) << "the body must have pushed the skirt";
     }
 }
 
