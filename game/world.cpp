@@ -26,6 +26,7 @@
 #ifdef DRAPE_HAVE_RENDER
 #include "engine/render/renderer.hpp"
 #include "systems/render_system.hpp"
+#include "systems/skin_cover_system.hpp"
 #include "systems/skinning_system.hpp"
 #endif
 
@@ -149,6 +150,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         camera.fov_y_rad = c.fov_deg * degrees;
         // The mesh is skinned for drawing only, once per frame, just before it is drawn.
         world.scheduler.add(make_skinning_system());
+        world.scheduler.add(make_skin_cover_system());
         world.scheduler.add(make_render_system(*world.renderer));
 #else
         return fail("rendering: this build has no render module (configured with -DDRAPE_RENDER=OFF)");

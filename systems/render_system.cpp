@@ -9,6 +9,7 @@
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
 #include "components/skinned_mesh.hpp"
+#include "systems/skin_cover_system.hpp"
 #include "systems/skinning_system.hpp"
 
 namespace drape {
@@ -132,6 +133,7 @@ Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& reg
     times_ms.reserve(static_cast<std::size_t>(frames));
     Image image;
     System skinning = make_skinning_system();
+    System cover = make_skin_cover_system();
     System system = make_render_system(renderer);
     FrameContext context;
     context.frame_dt_s = 1.0 / 60.0;
@@ -139,6 +141,7 @@ Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& reg
         const auto start = std::chrono::steady_clock::now();
         context.frame = static_cast<std::uint64_t>(i);
         skinning.run(registry, context);
+        cover.run(registry, context);
         system.run(registry, context);
         if (readback) {
             if (auto ok = renderer.read_pixels(image); !ok) return fail(ok.error().message);

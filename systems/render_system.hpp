@@ -43,8 +43,9 @@ void draw_registry(Renderer& renderer, Registry& registry);
 void update_follow_camera(Camera& camera, Registry& registry, double dt_s);
 
 /// Renders the registry's current state `frames` times through the render path (skinning
-/// system, then the render system: camera follow + draw + resolve); with `readback`, each frame is also read back to the
-/// CPU as an export would. Returns the wall time of each frame in ms, in order.
+/// system, skin cover system, then the render system: camera follow + draw + resolve);
+/// with `readback`, each frame is also read back to the CPU as an export would. Returns
+/// the wall time of each frame in ms, in order.
 [[nodiscard]] Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& registry, int frames,
                                                             bool readback = true);
 

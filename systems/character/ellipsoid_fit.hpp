@@ -24,8 +24,9 @@
 // `leg_reach_m` past its own skin along the leg (ellipsoid_solver.hpp, "reach"): a shin's
 // tip hidden inside the thigh at the rest pose would stand out behind the bent knee. The
 // fit then meets the target, and the sample skirt holds its strain (worst spring 9 %), but
-// up to a centimetre of thigh skin lies outside the tight ellipsoids and shows through the
-// skirt in every frame of the walk (docs/cloth.md, "Known limits").
+// the shared characters' garments tear more with it (docs/cloth.md, "Known limits"). Up to
+// a centimetre of thigh skin lies outside the tight ellipsoids; the skin cover system draws
+// it inside them (systems/skin_cover_system.hpp).
 //
 // Measures (measure_coverage):
 //  - coverage: the share of skin vertices inside some ellipsoid or within `tolerance_m` of

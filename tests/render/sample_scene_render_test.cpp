@@ -12,6 +12,7 @@
 #include "engine/render/renderer.hpp"
 #include "game/sample_scene.hpp"
 #include "game/world.hpp"
+#include "systems/skin_cover_system.hpp"
 #include "systems/skinning_system.hpp"
 
 namespace drape {
@@ -122,10 +123,13 @@ TEST(SampleSceneRender, MeshIsSkinnedOncePerDrawnFrameNotPerStep) {
         EXPECT_EQ(report->steps, 2);
     }
     EXPECT_EQ(skin.skinned_vertices - at_start, frames * vertices);
-    EXPECT_EQ(world->scheduler.system_names(Phase::render), (std::vector<std::string>{"skinning", "render"}));
-    // The drawn body is the current pose: the skinning matrices applied now give the same vertices.
+    EXPECT_EQ(world->scheduler.system_names(Phase::render), (std::vector<std::string>{"skinning", "skin_cover", "render"}));
+    // The drawn body is the current pose: the skinning matrices applied now, and the skirt's
+    // cover (systems/skin_cover_system.hpp), give the same vertices.
     const Matrix3X drawn = skin.positions;
     skin_characters(world->registry);
+    EXPECT_FALSE(drawn == skin.positions);  // the cover pulled the skin under the skirt in
+    cover_skin(world->registry);
     EXPECT_TRUE(drawn == skin.positions);
 }
 

@@ -1,0 +1,142 @@
+// Skin cover system: see skin_cover_system.hpp.
+#include "systems/skin_cover_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "components/skeleton.hpp"
+#include "components/skin_cover.hpp"
+#include "components/skinned_mesh.hpp"
+#include "systems/cloth/body.hpp"
+
+namespace drape {
+namespace {
+
+bool free_limb(BodyRegion r) {
+    return r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::head;
+}
+
+// Per bone of the character: true for the bones of an arm, a hand or the head (from its
+// colliders' regions) and every bone below them.
+std::vector<bool> free_limb_bones(Registry& registry, Entity character, const SkeletonAsset& skeleton) {
+    std::vector<bool> limb(skeleton.size(), false);
+    registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+        if (c.character == character && free_limb(c.region) && c.bone >= 0 && static_cast<std::size_t>(c.bone) < limb.size())
+            limb[static_cast<std::size_t>(c.bone)] = true;
+    });
+    for (std::size_t b = 0; b < limb.size(); ++b) {  // parents come first
+        const int parent = skeleton.parents[b];
+        if (parent >= 0 && static_cast<std::size_t>(parent) < b && limb[static_cast<std::size_t>(parent)]) limb[b] = true;
+    }
+    return limb;
+}
+
+// The covered vertices of `skin` under `g` (skin_cover_system.hpp, "Covered").
+void choose_cover(Registry& registry, const Garment& g, const SkinnedMesh& skin, const Skeleton& skeleton, SkinCover& cover) {
+    cover.vertices.clear();
+    cover.chosen_for = g.fabric;
+    const MeshAsset& mesh = *skin.mesh;
+    cover.mesh_vertices = mesh.vertex_count();
+    if (g.state.x.cols() == 0 || skin.positions.cols() != static_cast<Eigen::Index>(mesh.vertex_count())) return;
+    // The rest shape where the garment hangs now: its lowest point and its highest pin.
+    Affine3 anchor = Affine3::Identity();
+    if (g.body.anchor >= 0 && static_cast<std::size_t>(g.body.anchor) < g.body.colliders.size())
+        if (const auto* c = registry.try_get<EllipsoidCollider>(g.body.colliders[static_cast<std::size_t>(g.body.anchor)])) {
+            const EllipsoidFrame f = make_ellipsoid_frame(c->world);
+            anchor.linear() = f.rotation;
+            anchor.translation() = f.center;
+        }
+    Real low = std::numeric_limits<Real>::infinity(), high = -low;
+    const bool rest = g.body.rest_local.cols() == g.state.x.cols();
+    for (Eigen::Index p = 0; p < g.state.x.cols(); ++p) {
+        const Real y = rest ? (anchor * Vec3(g.body.rest_local.col(p))).y() : g.state.x(1, p);
+        low = std::min(low, y);
+    }
+    for (const PinBinding& pin : g.state.pins) high = std::max(high, g.state.x(1, static_cast<Eigen::Index>(pin.particle)));
+    if (g.state.pins.empty()) high = g.state.x.row(1).maxCoeff();
+    const std::vector<bool> limb = free_limb_bones(registry, g.body.character, *skeleton.asset);
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const Eigen::Index vi = static_cast<Eigen::Index>(v);
+        Eigen::Index strongest = 0;
+        mesh.bone_weights.col(vi).maxCoeff(&strongest);
+        const int bone = mesh.bone_indices(strongest, vi);
+        if (bone < 0 || static_cast<std::size_t>(bone) >= limb.size() || limb[static_cast<std::size_t>(bone)]) continue;
+        const Real y = skin.positions(1, vi);
+        if (y >= low && y <= high) cover.vertices.push_back(static_cast<std::uint32_t>(v));
+    }
+}
+
+// Pulls the covered vertices of `skin` that stand out of `frames` (skin_cover_system.hpp).
+std::uint64_t pull_in(const std::vector<EllipsoidFrame>& frames, const SkinCover& cover, SkinnedMesh& skin) {
+    std::uint64_t pulled = 0;
+    for (const std::uint32_t v : cover.vertices) {
+        const Eigen::Index vi = static_cast<Eigen::Index>(v);
+        const Vec3 x = skin.positions.col(vi);
+        Real nearest = std::numeric_limits<Real>::infinity();
+        const EllipsoidFrame* to = nullptr;
+        Real scale = 1;
+        bool inside = false;
+        for (const EllipsoidFrame& f : frames) {
+            const Vec3 d = x - f.center;
+            const Real y = (f.to_unit * d).norm();
+            if (y <= 1) {
+                inside = true;
+                break;
+            }
+            const Real outside = d.norm() * (1 - 1 / y);  // along the centre line to the surface
+            if (outside < nearest) {
+                nearest = outside;
+                to = &f;
+                scale = (1 - skin_cover_inset) / y;
+            }
+        }
+        if (inside || to == nullptr || !(nearest <= skin_cover_reach_m)) continue;
+        skin.positions.col(vi) = to->center + (x - to->center) * scale;
+        ++pulled;
+    }
+    return pulled;
+}
+
+void cover_all(Registry& registry, std::vector<EllipsoidFrame>& frames) {
+    registry.view<Garment>().each([&](Entity e, Garment& g) {
+        auto* skin = registry.try_get<SkinnedMesh>(g.body.character);
+        const auto* skeleton = registry.try_get<Skeleton>(g.body.character);
+        if (!skin || !skin->mesh || !skeleton || !skeleton->asset ||
+            skin->positions.cols() != static_cast<Eigen::Index>(skin->mesh->vertex_count()))
+            return;
+        SkinCover* cover = registry.try_get<SkinCover>(e);
+        if (cover == nullptr) cover = &registry.emplace<SkinCover>(e);
+        if (cover->chosen_for != g.fabric || cover->mesh_vertices != skin->mesh->vertex_count())
+            choose_cover(registry, g, *skin, *skeleton, *cover);
+        frames.clear();
+        for (Entity c : g.body.colliders)
+            if (const auto* collider = registry.try_get<EllipsoidCollider>(c)) {
+                const EllipsoidFrame f = make_ellipsoid_frame(collider->world);
+                if (f.active) frames.push_back(f);
+            }
+        if (!frames.empty()) cover->pulled += pull_in(frames, *cover, *skin);
+    });
+}
+
+}  // namespace
+
+void cover_skin(Registry& registry) {
+    std::vector<EllipsoidFrame> frames;
+    cover_all(registry, frames);
+}
+
+System make_skin_cover_system() {
+    System s;
+    s.name = "skin_cover";
+    s.phase = Phase::render;
+    s.reads = components<Garment, EllipsoidCollider, Skeleton>();
+    s.writes = components<SkinnedMesh>();  // and the SkinCover it adds to each garment (not a gate)
+    s.run = [frames = std::vector<EllipsoidFrame>{}](Registry& registry, const FrameContext&) mutable { cover_all(registry, frames); };
+    return s;
+}
+
+}  // namespace drape

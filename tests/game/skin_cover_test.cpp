@@ -1,0 +1,117 @@
+// The skin cover system: skin a garment covers is drawn inside the body the cloth collides
+// with, so that it cannot poke through the cloth; nothing else of the body moves.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include "components/ellipsoid_collider.hpp"
+#include "components/garment.hpp"
+#include "components/skin_cover.hpp"
+#include "components/skinned_mesh.hpp"
+#include "game/sample_scene.hpp"
+#include "game/world.hpp"
+#include "systems/cloth/body.hpp"
+#include "systems/skin_cover_system.hpp"
+#include "systems/skinning_system.hpp"
+#include "tests/shared_assets.hpp"
+
+namespace drape {
+namespace {
+
+namespace fs = std::filesystem;
+
+// How far `x` lies outside every ellipsoid of `g` along the nearest one's centre line (as
+// the system measures it); 0 inside one.
+Real outside_garment_body(Registry& registry, const Garment& g, const Vec3& x) {
+    Real nearest = std::numeric_limits<Real>::infinity();
+    for (Entity e : g.body.colliders) {
+        const EllipsoidFrame f = make_ellipsoid_frame(registry.get<EllipsoidCollider>(e).world);
+        const Vec3 d = x - f.center;
+        const Real y = (f.to_unit * d).norm();
+        if (y <= 1) return 0;
+        nearest = std::min(nearest, d.norm() * (1 - 1 / y));
+    }
+    return nearest;
+}
+
+struct CoverFigures {
+    std::size_t covered = 0;      ///< Vertices the garment covers.
+    std::size_t stood_out = 0;    ///< Covered and outside the garment's body within reach, before the cover.
+    Real deepest_before_m = 0;    ///< The farthest of those.
+};
+
+// Walks `scene`'s character `frames` frames, skins its mesh, runs the cover, and checks
+// every vertex: a covered one within reach outside the garment's body ends inside it, every
+// other one (uncovered, already inside, or farther out) is drawn where skinning put it.
+CoverFigures check_cover(const SceneDescription& scene, int frames) {
+    CoverFigures figures;
+    auto world = build_world(scene, {});
+    EXPECT_TRUE(world) << world.error().message;
+    if (!world) return figures;
+    for (int frame = 0; frame < frames; ++frame) EXPECT_TRUE(step_world(*world, 1.0 / 60.0));
+    skin_characters(world->registry);
+    SkinnedMesh& skin = world->registry.get<SkinnedMesh>(world->characters.at(0));
+    const Matrix3X skinned = skin.positions;
+    cover_skin(world->registry);
+    const Garment& g = world->registry.get<Garment>(world->garments.at(0));
+    const SkinCover* cover = world->registry.try_get<SkinCover>(world->garments.at(0));
+    EXPECT_NE(cover, nullptr);
+    if (cover == nullptr) return figures;
+    std::vector<bool> covered(static_cast<std::size_t>(skinned.cols()), false);
+    for (std::uint32_t v : cover->vertices) covered.at(v) = true;
+    figures.covered = cover->vertices.size();
+    for (Eigen::Index v = 0; v < skinned.cols(); ++v) {
+        const Real before = outside_garment_body(world->registry, g, skinned.col(v));
+        if (!covered[static_cast<std::size_t>(v)] || before == 0 || before > skin_cover_reach_m) {
+            EXPECT_TRUE(skin.positions.col(v) == skinned.col(v)) << "vertex " << v << " moved";
+            continue;
+        }
+        ++figures.stood_out;
+        figures.deepest_before_m = std::max(figures.deepest_before_m, before);
+        EXPECT_EQ(outside_garment_body(world->registry, g, skin.positions.col(v)), 0) << "vertex " << v;
+        EXPECT_LT((skin.positions.col(v) - skinned.col(v)).norm(), before + Real(0.02)) << "vertex " << v;
+    }
+    EXPECT_EQ(cover->pulled, figures.stood_out);
+    // Hands, arms and the head are never covered: the hands hang beside a skirt.
+    world->registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+        if (c.region != BodyRegion::hand && c.region != BodyRegion::head) return;
+        const MeshAsset& mesh = *skin.mesh;
+        for (std::uint32_t v : cover->vertices) {
+            Eigen::Index strongest = 0;
+            mesh.bone_weights.col(v).maxCoeff(&strongest);
+            EXPECT_NE(mesh.bone_indices(strongest, v), c.bone) << "vertex " << v << " of a " << body_region_name(c.region);
+        }
+    });
+    return figures;
+}
+
+TEST(SkinCover, TheSampleSkirtCoversTheHipsAndThighs) {
+    const CoverFigures f = check_cover(sample_scene(), 30);
+    EXPECT_GT(f.covered, 500u);
+    RecordProperty("covered", std::to_string(f.covered));
+    RecordProperty("stood_out", std::to_string(f.stood_out));
+}
+
+// Male_Casual's shirt hangs over his hips, up to a few centimetres outside the ellipsoids
+// the skirt lies on: without the cover it shows through the skirt below the waistband.
+TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
+    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/male_casual/Male_Casual.fbx";
+    DRAPE_REQUIRE_SHARED(file);
+    for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+        SceneDescription scene;
+        scene.characters.emplace_back();
+        scene.characters[0].file = file;
+        scene.garments.emplace_back();
+        scene.garments[0].type = type;
+        const CoverFigures f = check_cover(scene, 30);
+        EXPECT_GT(f.stood_out, 50u);
+        EXPECT_GT(f.deepest_before_m, Real(0.01));
+        RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_stood_out_before",
+                       std::to_string(f.stood_out) + " vertices, up to " + std::to_string(f.deepest_before_m) + " m");
+    }
+}
+
+}  // namespace
+}  // namespace drape
