@@ -31,7 +31,8 @@
 //      Overlapping ellipsoids can push a particle into a neighbour, so the particle's list
 //      is re-tested until it is outside all of them (every ellipsoid, when the push went
 //      beyond what the list bound still covers); after a few rounds it leaves from where it
-//      was detected by the shortest of a few straight ways out past every ellipsoid.
+//      was detected by the shortest of a few straight ways out past every ellipsoid, one of
+//      them toward the particle above it on its warp line (the cloth it hangs from).
 //      Within a substep, a particle that collided takes the velocity of its whole move,
 //      (x_end - x_start) / h, before the normal component is removed: the constraints
 //      and the push-out then cannot pump energy into a particle held against the body.
@@ -113,12 +114,15 @@ using DetectedPairs = std::vector<std::uint64_t>;
 /// (relative to the surface's motion), its tangential part slowed by Coulomb `friction`.
 /// `list_slack_m` (per particle; empty = unlimited): how far a particle may still move
 /// before its list could miss an ellipsoid; a particle pushed farther is re-tested against
-/// every ellipsoid. `respond_velocity` false: positions only.
+/// every ellipsoid. `respond_velocity` false: positions only. `above` (per particle; empty =
+/// none): the particle above it on its warp line, itself in the first row; a particle the
+/// re-tests cannot free may leave toward it (step 3).
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr,
                                   Real friction = 0, std::span<const Real> list_slack_m = {}, Eigen::Index first = 0,
-                                  Eigen::Index end = -1, bool respond_velocity = true);
+                                  Eigen::Index end = -1, bool respond_velocity = true,
+                                  std::span<const std::uint32_t> above = {});
 
 /// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
 [[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,

@@ -92,10 +92,13 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.weft_rest_right = weft_rest_right(t);
         s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.band, parts.count);
         s.below.resize(static_cast<std::size_t>(n));
+        s.above.resize(static_cast<std::size_t>(n));
         const std::uint32_t rows = t.particles_per_line;
         for (std::uint32_t line = 0; line < t.warp_lines; ++line)
-            for (std::uint32_t row = 0; row < rows; ++row)
+            for (std::uint32_t row = 0; row < rows; ++row) {
                 s.below[t.grid[line * rows + row]] = t.grid[line * rows + std::min(row + 1, rows - 1)];
+                s.above[t.grid[line * rows + row]] = t.grid[line * rows + (row > 0 ? row - 1 : 0)];
+            }
         s.part_counters.assign(parts.count, PartCounters{});
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;

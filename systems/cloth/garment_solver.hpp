@@ -74,6 +74,7 @@ struct GarmentSolver {
     std::vector<SpringSet> springs;          ///< The springs the model solves, in order.
     std::vector<Tethers> tethers;            ///< Long-range attachments from the pins, per line band.
     std::vector<std::uint32_t> below;        ///< Per particle: the particle below it on its line (itself in the last row).
+    std::vector<std::uint32_t> above;        ///< Per particle: the particle above it on its line (itself in the first row).
     VectorX weft_rest_right;                 ///< Per particle: rest length of the weft spring to the next line.
     VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
                                              ///< on its line (0 in the first row).

@@ -75,6 +75,43 @@ TEST(Collision, OverlappingEllipsoidsLeaveNoParticleInside) {
         for (const EllipsoidFrame& f : frames) ASSERT_LE(penetration_depth(f, x.col(p)), 1e-5) << "particle " << p;
 }
 
+// A particle caught where two spheres overlap, in neither's reach of the surface along its
+// own normals and centre lines (it leaves them only through the other sphere), while the
+// cloth above it lies outside both: it leaves toward that cloth, by the short way, and not
+// through a sphere.
+TEST(Collision, ACaughtParticleLeavesTowardTheParticleAboveIt) {
+    std::vector<EllipsoidFrame> frames;
+    for (const Real centre : {Real(0), Real(0.35)}) {
+        Affine3 t = Affine3::Identity();
+        t.translate(Vec3(centre, 1, 0));
+        t.scale(Real(0.3));
+        frames.push_back(make_ellipsoid_frame(t));
+    }
+    const Vec3 caught(0.175f, 1, 0), cloth(0.175f, 1.3f, 0);  // the cloth above: outside both
+    for (const EllipsoidFrame& f : frames) ASSERT_EQ(penetration_depth(f, cloth), 0);
+    const auto leave = [&](bool with_above) {
+        Matrix3X x(3, 2), v = Matrix3X::Zero(3, 2);
+        x.col(0) = cloth;
+        x.col(1) = caught;
+        VectorX inv_mass(2);
+        inv_mass << 0, 1;  // the particle above is pinned here
+        std::vector<std::uint64_t> last;
+        const std::vector<std::uint32_t> above = {0, 0};
+        const CollisionResult r = collide_particles(x, v, inv_mass, frames, nullptr, last, nullptr, 0, {}, 0, -1, false,
+                                                    with_above ? std::span<const std::uint32_t>(above) : std::span<const std::uint32_t>());
+        EXPECT_EQ(r.unresolved, 0u);
+        for (const EllipsoidFrame& f : frames) EXPECT_LE(penetration_depth(f, x.col(1)), 1e-5);
+        return Vec3(x.col(1));
+    };
+    // The spheres meet on a circle of radius sqrt(0.3^2 - 0.175^2) = 0.244 m around the
+    // particle: toward the cloth it leaves there, 0.244 m up.
+    const Vec3 out = leave(true);
+    EXPECT_NEAR((out - caught).norm(), 0.2437f, 0.002f);
+    EXPECT_GT(out.y(), caught.y());
+    // Without that way it leaves along the centre line, through the other sphere, farther.
+    EXPECT_GT((leave(false) - caught).norm(), 0.4f);
+}
+
 // Attaches a garment to the analytic body's character.
 using Dress = std::function<Entity(Registry&, Entity character, ClothModel, CollisionMode)>;
 
