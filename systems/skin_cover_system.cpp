@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "components/ellipsoid_collider.hpp"
@@ -35,21 +36,17 @@ std::vector<bool> free_limb_bones(Registry& registry, Entity character, const Sk
     return limb;
 }
 
-// The covered vertices of `skin` under `g` (skin_cover_system.hpp, "Covered").
-void choose_cover(Registry& registry, const Garment& g, const SkinnedMesh& skin, const Skeleton& skeleton, SkinCover& cover) {
+// The covered vertices of `skin` under `g` (skin_cover_system.hpp, "Covered"); `frames`: the
+// garment's colliders now (update_frames).
+void choose_cover(Registry& registry, const Garment& g, std::span<const EllipsoidFrame> frames, const SkinnedMesh& skin,
+                  const Skeleton& skeleton, SkinCover& cover) {
     cover.vertices.clear();
     cover.chosen_for = g.fabric;
     const MeshAsset& mesh = *skin.mesh;
     cover.mesh_vertices = mesh.vertex_count();
     if (g.state.x.cols() == 0 || skin.positions.cols() != static_cast<Eigen::Index>(mesh.vertex_count())) return;
     // The rest shape where the garment hangs now: its lowest point and its highest pin.
-    Affine3 anchor = Affine3::Identity();
-    if (g.body.anchor >= 0 && static_cast<std::size_t>(g.body.anchor) < g.body.colliders.size())
-        if (const auto* c = registry.try_get<EllipsoidCollider>(g.body.colliders[static_cast<std::size_t>(g.body.anchor)])) {
-            const EllipsoidFrame f = make_ellipsoid_frame(c->world);
-            anchor.linear() = f.rotation;
-            anchor.translation() = f.center;
-        }
+    const Affine3 anchor = anchor_frame(frames, g.body.anchor);
     Real low = std::numeric_limits<Real>::infinity(), high = -low;
     const bool rest = g.body.rest_local.cols() == g.state.x.cols();
     for (Eigen::Index p = 0; p < g.state.x.cols(); ++p) {
@@ -71,7 +68,7 @@ void choose_cover(Registry& registry, const Garment& g, const SkinnedMesh& skin,
 }
 
 // Pulls the covered vertices of `skin` that stand out of `frames` (skin_cover_system.hpp).
-std::uint64_t pull_in(const std::vector<EllipsoidFrame>& frames, const SkinCover& cover, SkinnedMesh& skin) {
+std::uint64_t pull_in(std::span<const EllipsoidFrame> frames, const SkinCover& cover, SkinnedMesh& skin) {
     std::uint64_t pulled = 0;
     for (const std::uint32_t v : cover.vertices) {
         const Eigen::Index vi = static_cast<Eigen::Index>(v);
@@ -81,6 +78,7 @@ std::uint64_t pull_in(const std::vector<EllipsoidFrame>& frames, const SkinCover
         Real scale = 1;
         bool inside = false;
         for (const EllipsoidFrame& f : frames) {
+            if (!f.active) continue;
             const Vec3 d = x - f.center;
             const Real y = (f.to_unit * d).norm();
             if (y <= 1) {
@@ -110,15 +108,10 @@ void cover_all(Registry& registry, std::vector<EllipsoidFrame>& frames) {
             return;
         SkinCover* cover = registry.try_get<SkinCover>(e);
         if (cover == nullptr) cover = &registry.emplace<SkinCover>(e);
+        update_frames(registry, g.body, frames, 1);
         if (cover->chosen_for != g.fabric || cover->mesh_vertices != skin->mesh->vertex_count())
-            choose_cover(registry, g, *skin, *skeleton, *cover);
-        frames.clear();
-        for (Entity c : g.body.colliders)
-            if (const auto* collider = registry.try_get<EllipsoidCollider>(c)) {
-                const EllipsoidFrame f = make_ellipsoid_frame(collider->world);
-                if (f.active) frames.push_back(f);
-            }
-        if (!frames.empty()) cover->pulled += pull_in(frames, *cover, *skin);
+            choose_cover(registry, g, frames, *skin, *skeleton, *cover);
+        cover->pulled += pull_in(frames, *cover, *skin);
     });
 }
 
