@@ -143,6 +143,18 @@ inline bool detect_block(const Matrix3X& x, Eigen::Index begin, Eigen::Index cou
     return found;
 }
 
+// detect_block for one particle p (a particle collided on its own), without the vector
+// lanes: the same test, each ellipsoid of `tested` in turn.
+inline bool detect_one(const Matrix3X& x, Eigen::Index p, std::span<const EllipsoidFrame> frames, std::uint64_t tested,
+                       std::uint64_t& hits) {
+    hits = 0;
+    for_each_bit(tested, [&](int e) {
+        const EllipsoidFrame& f = frames[static_cast<std::size_t>(e)];
+        if ((f.to_unit * (x.col(p) - f.center)).squaredNorm() < 1) hits |= std::uint64_t(1) << e;
+    });
+    return hits != 0;
+}
+
 // ---- Candidate lists (method §5, spatial locality); see collision.hpp step 1.
 
 // An ellipsoid's bit is refreshed in every list once the ellipsoid has moved this share of
@@ -480,7 +492,8 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected, Real friction,
                                   std::span<const Real> list_slack, Eigen::Index first, Eigen::Index last_particle,
-                                  bool respond_velocity, std::span<const std::uint32_t> above) {
+                                  bool respond_velocity, std::span<const std::uint32_t> above,
+                                  std::span<const std::uint32_t> listed) {
     CollisionResult r;
     const Eigen::Index n = x.cols();
     const Eigen::Index end = last_particle < 0 ? n : std::min(last_particle, n);
@@ -583,6 +596,23 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
 
     // 64 particles at a time against the ellipsoids of their lists (detect_block); brute
     // force lists every active ellipsoid for every free particle, through the same code.
+    if (!listed.empty()) {
+        // A few particles on their own: each tested against its list without vector lanes.
+        for (const std::uint32_t p : listed) {
+            const auto pi = static_cast<Eigen::Index>(p);
+            if (pi < first || pi >= end) continue;
+            const std::uint64_t list = inv_mass[pi] != 0 ? (candidates ? (*candidates)[p] & active : active) : 0;
+            r.tests += static_cast<std::uint64_t>(std::popcount(list));
+            std::uint64_t hits = 0;
+            if (detect_one(x, pi, frames, list, hits)) {
+                collide_one(pi, hits);
+            } else {
+                last_collided[p] = 0;
+                if (detected) (*detected)[p] = 0;
+            }
+        }
+        return r;
+    }
     LaneBits block_lists{}, block_hits{};
     for (Eigen::Index begin = first; begin < end; begin += detect_lanes) {
         const Eigen::Index count = std::min(detect_lanes, end - begin);

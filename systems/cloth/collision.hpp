@@ -116,13 +116,15 @@ using DetectedPairs = std::vector<std::uint64_t>;
 /// before its list could miss an ellipsoid; a particle pushed farther is re-tested against
 /// every ellipsoid. `respond_velocity` false: positions only. `above` (per particle; empty =
 /// none): the particle above it on its warp line, itself in the first row; a particle the
-/// re-tests cannot free may leave toward it (step 3).
+/// re-tests cannot free may leave toward it (step 3). `listed` (empty = every particle of
+/// the range): only these particles of [first, end), each tested on its own (for a few
+/// scattered particles, cheaper than their blocks of 64).
 CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass,
                                   std::span<const EllipsoidFrame> frames, const std::vector<std::uint64_t>* candidates,
                                   std::vector<std::uint64_t>& last_collided, DetectedPairs* detected = nullptr,
                                   Real friction = 0, std::span<const Real> list_slack_m = {}, Eigen::Index first = 0,
                                   Eigen::Index end = -1, bool respond_velocity = true,
-                                  std::span<const std::uint32_t> above = {});
+                                  std::span<const std::uint32_t> above = {}, std::span<const std::uint32_t> listed = {});
 
 /// Brute-force detection only (no response): bit set per particle of the ellipsoids containing it.
 [[nodiscard]] DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass,

@@ -237,87 +237,112 @@ VectorX weft_rest_right(const Fabric& f) {
     return right;
 }
 
-std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real stretch, Matrix3X& x,
-                              Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row) {
+namespace {
+
+// Scratch of one weft row's limit, sized for the fabric's rows.
+struct WeftRowScratch {
+    std::vector<std::uint32_t> p;
+    std::vector<Vec3> dir;
+    std::vector<Real> excess, diag, upper, dl, sweep;
+    std::vector<char> dirty;
+    WeftRowScratch(std::uint32_t lines, std::uint32_t springs)
+        : p(lines), dir(springs), excess(springs), diag(springs), upper(springs), dl(springs), sweep(springs), dirty(springs) {}
+};
+
+std::uint64_t limit_weft_row(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real scale, Matrix3X& x,
+                             Matrix3X& moves, std::uint32_t row, WeftRowScratch& scratch) {
     const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
     const std::uint32_t springs = f.closed ? n : n - 1;
-    const Real scale = 1 + stretch;
+    auto& [p, dir, excess, diag, upper, dl, sweep, dirty] = scratch;
     std::uint64_t corrected = 0;
-    std::vector<std::uint32_t> p(n);
-    std::vector<Vec3> dir(springs);
-    std::vector<Real> excess(springs), diag(springs), upper(springs), dl(springs), sweep(springs);
-    std::vector<char> dirty(springs);
-    for (std::uint32_t row = first_row; row < end_row; ++row) {
-        for (std::uint32_t line = 0; line < n; ++line) {
-            p[line] = f.grid[line * m + row];
-            moves.col(p[line]).setZero();
+    for (std::uint32_t line = 0; line < n; ++line) {
+        p[line] = f.grid[line * m + row];
+        moves.col(p[line]).setZero();
+    }
+    std::fill(dirty.begin(), dirty.end(), char(1));
+    for (int pass = 0; pass < weft_limit_passes; ++pass) {
+        bool over = false;
+        for (std::uint32_t i = 0; i < springs; ++i) {
+            // After the first pass only the springs of and next to a corrected run can
+            // have changed: the others stay within their bound.
+            if (!dirty[i]) {
+                excess[i] = -1;
+                continue;
+            }
+            dirty[i] = 0;
+            const std::uint32_t a = p[i], b = p[i + 1 < n ? i + 1 : 0];
+            const Real bound = scale * rest_right[a];
+            const Real length_sq = (x.col(b) - x.col(a)).squaredNorm();
+            excess[i] = -1;  // within its bound, or between two pins (the skin decides)
+            if (length_sq <= bound * bound || w[a] + w[b] == 0) continue;
+            excess[i] = std::sqrt(length_sq) - bound;
+            over = over || excess[i] > weft_limit_tolerance * rest_right[a];
         }
-        std::fill(dirty.begin(), dirty.end(), char(1));
-        for (int pass = 0; pass < weft_limit_passes; ++pass) {
-            bool over = false;
-            for (std::uint32_t i = 0; i < springs; ++i) {
-                // After the first pass only the springs of and next to a corrected run can
-                // have changed: the others stay within their bound.
-                if (!dirty[i]) {
-                    excess[i] = -1;
-                    continue;
-                }
-                dirty[i] = 0;
-                const std::uint32_t a = p[i], b = p[i + 1 < n ? i + 1 : 0];
-                const Real bound = scale * rest_right[a];
-                const Real length_sq = (x.col(b) - x.col(a)).squaredNorm();
-                excess[i] = -1;  // within its bound, or between two pins (the skin decides)
-                if (length_sq <= bound * bound || w[a] + w[b] == 0) continue;
-                excess[i] = std::sqrt(length_sq) - bound;
-                over = over || excess[i] > weft_limit_tolerance * rest_right[a];
+        if (!over) break;
+        // Each run of over-long springs is one chain: its linearised constraints
+        // K dl = -excess, K_jj = w_a + w_b, K_j,j+1 = -w_shared (u_j . u_j+1) with u the
+        // springs' directions, a tridiagonal system solved directly (Thomas). A closed
+        // row's runs start after a spring that is not over (all over: at line 0).
+        std::uint32_t start = 0;
+        if (f.closed) {
+            while (start < springs && excess[start] > 0) ++start;
+            if (start == springs) start = 0;
+        }
+        for (std::uint32_t k = 0; k < springs;) {
+            if (!(excess[(start + k) % springs] > 0)) {
+                ++k;
+                continue;
             }
-            if (!over) break;
-            // Each run of over-long springs is one chain: its linearised constraints
-            // K dl = -excess, K_jj = w_a + w_b, K_j,j+1 = -w_shared (u_j . u_j+1) with u the
-            // springs' directions, a tridiagonal system solved directly (Thomas). A closed
-            // row's runs start after a spring that is not over (all over: at line 0).
-            std::uint32_t start = 0;
-            if (f.closed) {
-                while (start < springs && excess[start] > 0) ++start;
-                if (start == springs) start = 0;
+            std::uint32_t len = 0;
+            while (k + len < springs && excess[(start + k + len) % springs] > 0) ++len;
+            const auto spring = [&](std::uint32_t j) { return (start + k + j) % springs; };
+            for (std::uint32_t j = 0; j < len; ++j) {
+                const std::uint32_t i = spring(j), a = p[i], b = p[(i + 1) % n];
+                dir[i] = (x.col(b) - x.col(a)).normalized();
             }
-            for (std::uint32_t k = 0; k < springs;) {
-                if (!(excess[(start + k) % springs] > 0)) {
-                    ++k;
-                    continue;
-                }
-                std::uint32_t len = 0;
-                while (k + len < springs && excess[(start + k + len) % springs] > 0) ++len;
-                const auto spring = [&](std::uint32_t j) { return (start + k + j) % springs; };
-                for (std::uint32_t j = 0; j < len; ++j) {
-                    const std::uint32_t i = spring(j), a = p[i], b = p[(i + 1) % n];
-                    dir[i] = (x.col(b) - x.col(a)).normalized();
-                }
-                for (std::uint32_t j = 0; j < len; ++j) {
-                    const std::uint32_t i = spring(j), a = p[i], b = p[(i + 1) % n];
-                    diag[j] = w[a] + w[b];
-                    upper[j] = j + 1 < len ? -w[b] * dir[i].dot(dir[spring(j + 1)]) : Real(0);
-                    // Forward sweep.
-                    const Real lower = j > 0 ? upper[j - 1] : Real(0);
-                    const Real denom = diag[j] - (j > 0 ? lower * sweep[j - 1] : Real(0));
-                    sweep[j] = upper[j] / denom;
-                    dl[j] = (-excess[i] - (j > 0 ? lower * dl[j - 1] : Real(0))) / denom;
-                }
-                for (std::uint32_t j = len - 1; j-- > 0;) dl[j] -= sweep[j] * dl[j + 1];
-                for (std::uint32_t j = 0; j < len; ++j) {
-                    const std::uint32_t i = spring(j), a = p[i], b = p[(i + 1) % n];
-                    const Vec3 step = dir[i] * dl[j];
-                    x.col(a) -= w[a] * step;
-                    moves.col(a) -= w[a] * step;
-                    x.col(b) += w[b] * step;
-                    moves.col(b) += w[b] * step;
-                }
-                for (std::uint32_t j = 0; j < len + 2; ++j) dirty[(start + k + j + springs - 1) % springs] = 1;
-                corrected += len;
-                k += len;
+            for (std::uint32_t j = 0; j < len; ++j) {
+                const std::uint32_t i = spring(j), a = p[i], b = p[(i + 1) % n];
+                diag[j] = w[a] + w[b];
+                upper[j] = j + 1 < len ? -w[b] * dir[i].dot(dir[spring(j + 1)]) : Real(0);
+                // Forward sweep.
+                const Real lower = j > 0 ? upper[j - 1] : Real(0);
+                const Real denom = diag[j] - (j > 0 ? lower * sweep[j - 1] : Real(0));
+                sweep[j] = upper[j] / denom;
+                dl[j] = (-excess[i] - (j > 0 ? lower * dl[j - 1] : Real(0))) / denom;
             }
+            for (std::uint32_t j = len - 1; j-- > 0;) dl[j] -= sweep[j] * dl[j + 1];
+            for (std::uint32_t j = 0; j < len; ++j) {
+                const std::uint32_t i = spring(j), a = p[i], b = p[(i + 1) % n];
+                const Vec3 step = dir[i] * dl[j];
+                x.col(a) -= w[a] * step;
+                moves.col(a) -= w[a] * step;
+                x.col(b) += w[b] * step;
+                moves.col(b) += w[b] * step;
+            }
+            for (std::uint32_t j = 0; j < len + 2; ++j) dirty[(start + k + j + springs - 1) % springs] = 1;
+            corrected += len;
+            k += len;
         }
     }
+    return corrected;
+}
+
+}  // namespace
+
+std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real stretch, Matrix3X& x,
+                              Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row) {
+    WeftRowScratch scratch(f.warp_lines, f.closed ? f.warp_lines : f.warp_lines - 1);
+    std::uint64_t corrected = 0;
+    for (std::uint32_t row = first_row; row < end_row; ++row)
+        corrected += limit_weft_row(f, rest_right, w, 1 + stretch, x, moves, row, scratch);
+    return corrected;
+}
+
+std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real stretch, Matrix3X& x,
+                              Matrix3X& moves, std::span<const std::uint32_t> rows) {
+    WeftRowScratch scratch(f.warp_lines, f.closed ? f.warp_lines : f.warp_lines - 1);
+    std::uint64_t corrected = 0;
+    for (const std::uint32_t row : rows) corrected += limit_weft_row(f, rest_right, w, 1 + stretch, x, moves, row, scratch);
     return corrected;
 }
 

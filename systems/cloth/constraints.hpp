@@ -127,4 +127,8 @@ inline constexpr Real weft_limit_tolerance = Real(0.01);
 std::uint64_t limit_weft_rows(const Fabric& fabric, const VectorX& rest_right, const VectorX& inv_mass, Real stretch,
                               Matrix3X& x, Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row);
 
+/// The same on the rows listed, in their order.
+std::uint64_t limit_weft_rows(const Fabric& fabric, const VectorX& rest_right, const VectorX& inv_mass, Real stretch,
+                              Matrix3X& x, Matrix3X& moves, std::span<const std::uint32_t> rows);
+
 }  // namespace drape

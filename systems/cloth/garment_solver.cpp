@@ -93,13 +93,16 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.band, parts.count);
         s.below.resize(static_cast<std::size_t>(n));
         s.above.resize(static_cast<std::size_t>(n));
+        s.grid_place.resize(static_cast<std::size_t>(n));
         const std::uint32_t rows = t.particles_per_line;
         for (std::uint32_t line = 0; line < t.warp_lines; ++line)
             for (std::uint32_t row = 0; row < rows; ++row) {
+                s.grid_place[t.grid[line * rows + row]] = line * rows + row;
                 s.below[t.grid[line * rows + row]] = t.grid[line * rows + std::min(row + 1, rows - 1)];
                 s.above[t.grid[line * rows + row]] = t.grid[line * rows + (row > 0 ? row - 1 : 0)];
             }
         s.part_counters.assign(parts.count, PartCounters{});
+        s.pushed.assign(parts.count, {});
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;
         s.built_fabric = &t;
@@ -108,6 +111,8 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
     }
     if (s.warp_moves.cols() != n) s.warp_moves = Matrix3X::Zero(3, n);
     if (s.weft_moves.cols() != n) s.weft_moves = Matrix3X::Zero(3, n);
+    if (s.repair_warp_moves.cols() != n) s.repair_warp_moves = Matrix3X::Zero(3, n);
+    if (s.repair_weft_moves.cols() != n) s.repair_weft_moves = Matrix3X::Zero(3, n);
     if (s.x_round.cols() != n) s.x_round = Matrix3X::Zero(3, n);
     if (s.x_start.cols() != n) s.x_start = Matrix3X::Zero(3, n);
     if (s.push.cols() != n) s.push = Matrix3X::Zero(3, n);

@@ -75,6 +75,7 @@ struct GarmentSolver {
     std::vector<Tethers> tethers;            ///< Long-range attachments from the pins, per line band.
     std::vector<std::uint32_t> below;        ///< Per particle: the particle below it on its line (itself in the last row).
     std::vector<std::uint32_t> above;        ///< Per particle: the particle above it on its line (itself in the first row).
+    std::vector<std::uint32_t> grid_place;   ///< Per particle: line x particles_per_line + row (Fabric::grid's inverse).
     VectorX weft_rest_right;                 ///< Per particle: rest length of the weft spring to the next line.
     VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
                                              ///< on its line (0 in the first row).
@@ -98,6 +99,12 @@ struct GarmentSolver {
     std::vector<std::uint64_t> contacts;     ///< Per particle: ellipsoids it touched in this substep's rounds.
     Matrix3X warp_moves;                     ///< Per particle: the warp limit's move this substep.
     Matrix3X weft_moves;                     ///< Per particle: the weft limit's move this substep.
+    Matrix3X repair_warp_moves;              ///< Per particle: the warp limit's move in the current repair round.
+    Matrix3X repair_weft_moves;              ///< Per particle: the weft limit's move in the current repair round.
+    VectorX repair_inv_mass;                 ///< The limits' inverse masses in the repair rounds (pushed particles heavier).
+    std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
+    std::vector<std::uint32_t> repair_rows, repair_lines, repair_moved; ///< The repair rounds' choices.
+    std::vector<std::uint64_t> repair_touched; ///< Per particle of repair_moved: its last_collided before a repair collision.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.
 };
 

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <span>
 
 #include "components/ellipsoid_collider.hpp"
 #include "systems/cloth/body.hpp"
@@ -27,6 +28,11 @@ constexpr Real limit_share = Real(0.5);
 // Dynamic follow-the-leader's damping s_damping (Müller et al. 2012): the share of a
 // follower's warp-limit move that its leader's velocity gives back.
 constexpr Real leader_damping = Real(0.9);
+
+// Contact repair (repair_pushes): at most this many rounds per substep, and the share of its
+// inverse mass a pushed particle keeps in them.
+constexpr int repair_rounds = 48;
+constexpr Real pushed_weight = Real(0.1);
 
 ClothSubstep make_substep(int index, int count, double fixed_dt_s) noexcept {
     return ClothSubstep{index, count, fixed_dt_s, fixed_dt_s / count};
@@ -219,8 +225,10 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Ei
 // scene's walk the warp limit 153 of 837 per substep, 61 of them by a millimetre or more):
 // in band `part`, each block of 64 particles holding one is collided again, in the
 // garment's collision mode (the band's lists brought up to date first), positions only; the
-// last round's contacts are kept.
+// last round's contacts are kept. The particles it pushes go to s.pushed[part].
 void collide_limit_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCounters& c) {
+    std::vector<std::uint32_t>& pushed = s.pushed[part];
+    pushed.clear();
     constexpr Eigen::Index block = 64;
     bool lists_current = false;
     std::array<std::uint64_t, block> before{};
@@ -241,9 +249,125 @@ void collide_limit_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCou
                 const std::size_t i = static_cast<std::size_t>(p);
                 s.contacts[i] |= s.last_collided[i];
                 s.last_collided[i] |= before[static_cast<std::size_t>(p - begin)];  // last round's contacts stay
+                if (g.state.x.col(p) != s.x_round.col(p)) pushed.push_back(static_cast<std::uint32_t>(p));
             }
             s.push.middleCols(begin, end - begin) += g.state.x.middleCols(begin, end - begin) - s.x_round.middleCols(begin, end - begin);
         }
+    }
+}
+
+// Which springs of free particle p are longer than (1 + limit) x rest: bit 0 a warp spring
+// (to the particle above or below on its line), bit 1 a weft spring (to a neighbouring line).
+int over_limit(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::uint32_t p, Real limit) {
+    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+    const std::uint32_t line = s.grid_place[p] / m, row = s.grid_place[p] % m;
+    const Real scale = 1 + limit;
+    const auto over = [&](std::uint32_t q, Real rest) { return (x.col(q) - x.col(p)).squaredNorm() > scale * scale * rest * rest; };
+    int springs = 0;
+    if ((row > 0 && over(s.above[p], s.warp_rest_above[p])) || (row + 1 < m && over(s.below[p], s.warp_rest_above[s.below[p]])))
+        springs |= 1;
+    if ((line > 0 || f.closed) && over(f.grid[((line + n - 1) % n) * m + row], s.weft_rest_right[f.grid[((line + n - 1) % n) * m + row]]))
+        springs |= 2;
+    else if ((line + 1 < n || f.closed) && over(f.grid[((line + 1) % n) * m + row], s.weft_rest_right[p]))
+        springs |= 2;
+    return springs;
+}
+
+// The particles listed (moved after the lists were last brought up to date) collided again,
+// positions only, each against every active ellipsoid (they are few and scattered: no list,
+// no blocks); the particles pushed go to s.pushed[0], the other parts' lists are emptied.
+void collide_moved(Garment& g, GarmentSolver& s, std::span<const std::uint32_t> moved) {
+    for (std::vector<std::uint32_t>& part : s.pushed) part.clear();
+    Matrix3X& x = g.state.x;
+    s.repair_touched.resize(moved.size());
+    for (std::size_t k = 0; k < moved.size(); ++k) {
+        s.x_round.col(moved[k]) = x.col(moved[k]);
+        s.repair_touched[k] = s.last_collided[moved[k]];
+    }
+    const CollisionResult r = collide_particles(x, g.state.v, g.state.inv_mass, s.frames, nullptr, s.last_collided, nullptr,
+                                                g.config.material.friction, {}, 0, -1, /*respond_velocity=*/false, s.above, moved);
+    PartCounters& c = s.part_counters.front();
+    c.collision_tests += r.tests;
+    c.collisions += r.collisions;
+    c.max_penetration_m = std::max(c.max_penetration_m, r.max_penetration_m);
+    for (std::size_t k = 0; k < moved.size(); ++k) {
+        const std::uint32_t p = moved[k];
+        s.contacts[p] |= s.last_collided[p];
+        s.last_collided[p] |= s.repair_touched[k];  // the last round's contacts stay
+        if (x.col(p) == s.x_round.col(p)) continue;
+        s.push.col(p) += x.col(p) - s.x_round.col(p);
+        s.pushed.front().push_back(p);
+    }
+}
+
+// Contact repair (an extension of method §4.1-§5, docs/cloth.md "Contact repair"): the last
+// collision can push a particle far from neighbours the limits had just brought within
+// reach (a heel lifting the hem, the back of a bent knee), and nothing after it restores the
+// springs. Rounds of limit and collision: the lines and rows of every particle that moved
+// (pushed, or moved by the last round's limits) and has a spring over the strain limit are
+// limited again, a particle pushed in this substep taken as heavier (inverse mass x
+// pushed_weight) so that the limits move its neighbours toward it rather than it back into
+// the body; then what they moved is collided again. Until no spring of a moved particle is
+// over the limit, or repair_rounds rounds.
+void repair_pushes(Garment& g, GarmentSolver& s) {
+    const Fabric& f = *g.fabric;
+    const std::uint32_t m = f.particles_per_line;
+    const Real limit = g.config.material.strain_limit;
+    const Real stretch = limit_share * limit;
+    Matrix3X& x = g.state.x;
+    std::vector<std::uint32_t>& rows = s.repair_rows;
+    std::vector<std::uint32_t>& lines = s.repair_lines;
+    std::vector<std::uint32_t>& moved = s.repair_moved;  // by the last limits
+    moved.clear();
+    for (Eigen::Index p = 0; p < x.cols(); ++p)
+        if (s.warp_moves.col(p).squaredNorm() > 0 || s.weft_moves.col(p).squaredNorm() > 0) moved.push_back(static_cast<std::uint32_t>(p));
+    bool weighted = false;  // repair_inv_mass holds this substep's weights
+    const auto weights = [&]() -> VectorX& {
+        if (!weighted) s.repair_inv_mass = s.inv_mass;
+        weighted = true;
+        return s.repair_inv_mass;
+    };
+    for (int round = 0; round < repair_rounds; ++round) {
+        rows.clear();
+        lines.clear();
+        const auto choose = [&](std::uint32_t p) {
+            const int springs = over_limit(f, s, x, p, limit);
+            if (springs & 1) lines.push_back(s.grid_place[p] / m);
+            if (springs & 2) rows.push_back(s.grid_place[p] % m);
+            return springs != 0;
+        };
+        for (const std::vector<std::uint32_t>& part : s.pushed)
+            for (const std::uint32_t p : part)
+                if (choose(p)) weights()[p] = s.inv_mass[p] * pushed_weight;
+        for (const std::uint32_t p : moved) choose(p);
+        if (rows.empty() && lines.empty()) return;
+        std::sort(rows.begin(), rows.end());
+        rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+        std::sort(lines.begin(), lines.end());
+        lines.erase(std::unique(lines.begin(), lines.end()), lines.end());
+        const VectorX& w = weights();
+        for (const std::uint32_t line : lines) {
+            limit_warp_lines(f, s.warp_rest_above, w, stretch, x, s.repair_warp_moves, line, line + 1);
+            for (std::uint32_t row = 0; row < m; ++row) {
+                const std::uint32_t p = f.grid[line * m + row];
+                s.warp_moves.col(p) += s.repair_warp_moves.col(p);  // given back to the leader's velocity
+            }
+        }
+        limit_weft_rows(f, s.weft_rest_right, w, stretch, x, s.repair_weft_moves, rows);
+        // What the limits moved is collided again and looked at in the next round; the
+        // moves go back to zero.
+        moved.clear();
+        const auto take = [&](Matrix3X& moves, std::uint32_t p) {
+            if (moves.col(p).squaredNorm() > 0) moved.push_back(p);
+            moves.col(p).setZero();
+        };
+        for (const std::uint32_t line : lines)
+            for (std::uint32_t row = 0; row < m; ++row) take(s.repair_warp_moves, f.grid[line * m + row]);
+        for (const std::uint32_t row : rows)
+            for (std::uint32_t line = 0; line < f.warp_lines; ++line) take(s.repair_weft_moves, f.grid[line * m + row]);
+        std::sort(moved.begin(), moved.end());  // in index order, once each
+        moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
+        collide_moved(g, s, moved);
     }
 }
 
@@ -264,7 +388,12 @@ void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, co
     if (moved && g.config.collision == CollisionMode::candidate_lists) prepare_candidate_lists(g, s);
     for_each_part(s.parts.count, [&](std::size_t k) {
         PartCounters& c = s.part_counters[k] = PartCounters{};
+        s.pushed[k].clear();
         if (moved) collide_limit_moves(g, s, k, c);
+    });
+    if (moved) repair_pushes(g, s);
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        PartCounters& c = s.part_counters[k];
         for (const auto [first, end] : s.parts.runs[k]) {
             update_velocities(g, s, sub, first, end);
             c.finite = c.finite && all_finite(g.state.x.middleCols(first, end - first)) &&

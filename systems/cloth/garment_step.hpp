@@ -18,10 +18,11 @@
 //     finish_constraints      cloth_constraint: Provot's limit along every warp line from
 //                             the pins down, then along every weft row (constraints.hpp
 //                             limit_warp_lines, limit_weft_rows)
-//     finish_collision        cloth_collision: a last collision round, then the velocities of
-//                             the free particles from the substep's move (less the push-outs
-//                             and the warp limit's moves; at contacts no approach, friction),
-//                             then the non-finite check
+//     finish_collision        cloth_collision: a last collision round, contact repair
+//                             (rounds of limits and collision where a push left a spring over
+//                             the limit), then the velocities of the free particles from the
+//                             substep's move (less the push-outs and the warp limit's moves;
+//                             at contacts no approach, friction), then the non-finite check
 #pragma once
 
 #include <functional>
@@ -69,7 +70,10 @@ void collide_round(const Registry& registry, Garment& garment, GarmentSolver& so
 void finish_constraints(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
 /// After finish_constraints: a last collision round (the limits moved particles), then
-/// the velocities of the free particles from their move over the substep: the warp limit's
+/// contact repair: rounds of the limits on the lines and rows where a particle that moved
+/// has a spring over the strain limit (particles the collision pushed weighted as heavy)
+/// and a collision of what they moved, until none has (at most 48 rounds; docs/cloth.md);
+/// then the velocities of the free particles from their move over the substep: the warp limit's
 /// move of the particle below on the line given back (dynamic follow-the-leader), the
 /// push-outs left out; where a particle touched an ellipsoid, no velocity toward it relative
 /// to its surface and Coulomb friction. Then the non-finite check: a garment with a NaN or
