@@ -154,22 +154,11 @@ TEST(StrainAfterFrame, Layer2OfTheSkirtIsWithinTheContractOnTheWalk) {
     expect_layer2_within_contract(GarmentType::skirt, 600, 300000);
 }
 
-// The default dress (10,080 particles, hem at the ankles) misses the contract on the walk:
-// the shins and heels lift and push its hem faster than four rounds spread the push over
-// its 120 lines (docs/cloth.md "Known limits"; `drape bench quality` measures it). Its
-// layer 2 is held to what the solver does guarantee there: nothing non-finite, no reset,
-// nothing left inside after the frame.
-TEST(StrainAfterFrame, Layer2OfTheDressStaysFiniteAndOutOfTheBodyOnTheWalk) {
-    HandStepped s(GarmentType::dress, ClothModel::simplified);
-    ASSERT_TRUE(s.ok());
-    double deepest = 0;
-    for (int frame = 0; frame < 120; ++frame) {
-        ASSERT_TRUE(s.step());
-        deepest = std::max(deepest, double(measure_garment(s.garment, s.solver.frames).penetration_m));
-    }
-    EXPECT_EQ(s.garment.counters.non_finite_values, 0u);
-    EXPECT_EQ(s.garment.counters.resets, 0u);
-    EXPECT_LE(deepest, contract_penetration_m);
+// The default dress (10,080 particles, hem at the shins): its shins and heels lift and push
+// the hem every step, so this holds only if the last collision's push-outs are carried onto
+// their neighbours (contact repair, docs/cloth.md).
+TEST(StrainAfterFrame, Layer2OfTheDressIsWithinTheContractOnTheWalk) {
+    expect_layer2_within_contract(GarmentType::dress, 600, 5000000);
 }
 
 // The push-outs: every structural spring with an end that a collision round moved during the
