@@ -16,6 +16,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <string>
 #include <utility>
 
 #include "engine/assets/character_import.hpp"
@@ -456,30 +457,35 @@ TEST(AvatarBuilds, FittedEllipsoidsHugShortWideAndLongLeggedBodies) {
     }
 }
 
-// The skirt on the wide and the long-legged build, 600 frames of their walk, after every
-// frame: the contract asked of characters the team did not tune for (strain p99 <= 10 %,
-// max <= 20 %, nothing left inside after the frame beyond 2 mm, pins outside). Measured:
-// max 7.7 % (wide) and 7.5 % (long-legged). The short build misses it (43 %, its hem
-// caught round a shin) and the dress misses on all three (docs/cloth.md, "Known limits").
-TEST(AvatarBuilds, SkirtHoldsTheContractOnTheWideAndLongLeggedBuilds) {
+// The skirt and the dress on the wide and the long-legged build, 600 frames of their walk,
+// after every frame: the contract asked of characters the team did not tune for (strain p99
+// <= 10 %, max <= 20 %, nothing left inside after the frame beyond 2 mm, pins outside).
+// Measured: skirt max 7.7 % (wide) and 7.5 % (long-legged), dress 10.0 % on both. The short
+// build misses it (skirt 45 %, its hem caught round a shin; dress 211 % in its first frame,
+// its hem starting inside a foot: docs/cloth.md, "Known limits").
+TEST(AvatarBuilds, SkirtAndDressHoldTheContractOnTheWideAndLongLeggedBuilds) {
     for (const auto& [name, model] : unusual_builds()) {
         if (name == "short") continue;
-        SCOPED_TRACE(name);
-        const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / ("avatar_build_skirt_" + name + ".glb");
-        ASSERT_TRUE(write_avatar(model, path));
-        SceneDescription scene = sample_scene();
-        scene.characters.at(0).file = path;
-        auto world = build_world(scene, {});
-        ASSERT_TRUE(world) << world.error().message;
-        for (int frame = 0; frame < 600; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
-        const GarmentStats g = run_stats(*world).garments.at(0);
-        EXPECT_LE(g.strain_p99, 0.10);
-        EXPECT_LE(g.strain_max, 0.20);
-        EXPECT_LE(g.penetration_after_frame_m, 2e-3);
-        EXPECT_LE(g.pins_inside_m, 5e-3);
-        EXPECT_EQ(g.nonfinite, 0u);
-        EXPECT_EQ(g.resets, 0u);
-        EXPECT_GT(g.penetration_before_response_m, 1e-3) << "the body must have pushed the skirt";
+        for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+            const std::string garment = type == GarmentType::skirt ? "skirt" : "dress";
+            SCOPED_TRACE(name + ", " + garment);
+            const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / ("avatar_build_" + garment + "_" + name + ".glb");
+            ASSERT_TRUE(write_avatar(model, path));
+            SceneDescription scene = sample_scene();
+            scene.characters.at(0).file = path;
+            scene.garments.at(0).type = type;
+            auto world = build_world(scene, {});
+            ASSERT_TRUE(world) << world.error().message;
+            for (int frame = 0; frame < 600; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+            const GarmentStats g = run_stats(*world).garments.at(0);
+            EXPECT_LE(g.strain_p99, 0.10);
+            EXPECT_LE(g.strain_max, 0.20);
+            EXPECT_LE(g.penetration_after_frame_m, 2e-3);
+            EXPECT_LE(g.pins_inside_m, 5e-3);
+            EXPECT_EQ(g.nonfinite, 0u);
+            EXPECT_EQ(g.resets, 0u);
+            EXPECT_GT(g.penetration_before_response_m, 1e-3) << "the body must have pushed the garment";
+        }
     }
 }
 
