@@ -317,10 +317,14 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
     Matrix3X& x = g.state.x;
     std::vector<std::uint32_t>& rows = s.repair_rows;
     std::vector<std::uint32_t>& lines = s.repair_lines;
-    std::vector<std::uint32_t>& moved = s.repair_moved;  // by the last limits
+    // Moved by the last limits: first, those the weft limit moved. The warp limit leaves no
+    // warp spring over its bound and the weft limit then checks every weft spring, so a
+    // spring over the limit after both has an end the weft limit moved (a row it did not
+    // settle in its passes, or a warp spring its sideways move stretched).
+    std::vector<std::uint32_t>& moved = s.repair_moved;
     moved.clear();
     for (Eigen::Index p = 0; p < x.cols(); ++p)
-        if (s.warp_moves.col(p).squaredNorm() > 0 || s.weft_moves.col(p).squaredNorm() > 0) moved.push_back(static_cast<std::uint32_t>(p));
+        if (s.weft_moves.col(p).squaredNorm() > 0) moved.push_back(static_cast<std::uint32_t>(p));
     bool weighted = false;  // repair_inv_mass holds this substep's weights
     const auto weights = [&]() -> VectorX& {
         if (!weighted) s.repair_inv_mass = s.inv_mass;
