@@ -304,7 +304,7 @@ void collide_moved(Garment& g, GarmentSolver& s, std::span<const std::uint32_t> 
 // collision can push a particle far from neighbours the limits had just brought within
 // reach (a heel lifting the hem, the back of a bent knee), and nothing after it restores the
 // springs. Rounds of limit and collision: the lines and rows of every particle that moved
-// (pushed, or moved by the last round's limits) and has a spring over the strain limit are
+// (pushed, or moved by the last limits) and has a spring over the strain limit are
 // limited again, a particle pushed in this substep taken as heavier (inverse mass x
 // pushed_weight) so that the limits move its neighbours toward it rather than it back into
 // the body; then what they moved is collided again. Until no spring of a moved particle is
