@@ -594,8 +594,6 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         v.col(p) = vp;
     };
 
-    // 64 particles at a time against the ellipsoids of their lists (detect_block); brute
-    // force lists every active ellipsoid for every free particle, through the same code.
     if (!listed.empty()) {
         // A few particles on their own: each tested against its list without vector lanes.
         for (const std::uint32_t p : listed) {
@@ -613,6 +611,8 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         }
         return r;
     }
+    // 64 particles at a time against the ellipsoids of their lists (detect_block); brute
+    // force lists every active ellipsoid for every free particle, through the same code.
     LaneBits block_lists{}, block_hits{};
     for (Eigen::Index begin = first; begin < end; begin += detect_lanes) {
         const Eigen::Index count = std::min(detect_lanes, end - begin);

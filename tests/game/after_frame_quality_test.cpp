@@ -35,33 +35,19 @@ void expect_clean(const GarmentStats& g) {
     EXPECT_GT(g.penetration_before_response_m, 1e-3);
 }
 
-TEST(AfterFrameQuality, SimplifiedSkirtOnTheWalk) {
-    const GarmentStats g = walk(GarmentType::skirt, ClothModel::simplified, 600);
+// Clean, and the structural strain within the contract (p99 <= 10 %, max <= 15 %), over 600
+// frames of the walk.
+void expect_contract(GarmentType type, ClothModel model) {
+    const GarmentStats g = walk(type, model, 600);
     expect_clean(g);
     EXPECT_LE(g.strain_p99, 0.10);
     EXPECT_LE(g.strain_max, 0.15);
 }
 
-TEST(AfterFrameQuality, ClassicSkirtOnTheWalk) {
-    const GarmentStats g = walk(GarmentType::skirt, ClothModel::classic, 600);
-    expect_clean(g);
-    EXPECT_LE(g.strain_p99, 0.10);
-    EXPECT_LE(g.strain_max, 0.15);
-}
-
-TEST(AfterFrameQuality, SimplifiedDressOnTheWalk) {
-    const GarmentStats g = walk(GarmentType::dress, ClothModel::simplified, 600);
-    expect_clean(g);
-    EXPECT_LE(g.strain_p99, 0.10);
-    EXPECT_LE(g.strain_max, 0.15);
-}
-
-TEST(AfterFrameQuality, ClassicDressOnTheWalk) {
-    const GarmentStats g = walk(GarmentType::dress, ClothModel::classic, 600);
-    expect_clean(g);
-    EXPECT_LE(g.strain_p99, 0.10);
-    EXPECT_LE(g.strain_max, 0.15);
-}
+TEST(AfterFrameQuality, SimplifiedSkirtOnTheWalk) { expect_contract(GarmentType::skirt, ClothModel::simplified); }
+TEST(AfterFrameQuality, ClassicSkirtOnTheWalk) { expect_contract(GarmentType::skirt, ClothModel::classic); }
+TEST(AfterFrameQuality, SimplifiedDressOnTheWalk) { expect_contract(GarmentType::dress, ClothModel::simplified); }
+TEST(AfterFrameQuality, ClassicDressOnTheWalk) { expect_contract(GarmentType::dress, ClothModel::classic); }
 
 }  // namespace
 }  // namespace drape
