@@ -692,7 +692,7 @@ void prepare_candidate_lists(Garment& g, GarmentSolver& solver) {
     const std::size_t parts = solver.parts.runs.size();
     const bool valid = lists.valid && lists.parts.size() == parts && lists.reference_x.cols() == n &&
                        lists.clearance_m.rows() == n && lists.clearance_m.cols() == static_cast<Eigen::Index>(e_count) &&
-                       lists.bits.size() == static_cast<std::size_t>(n) &&
+                       lists.bits.size() == static_cast<std::size_t>(n) && lists.min_clearance_m.size() == n &&
                        std::all_of(lists.parts.begin(), lists.parts.end(),
                                    [&](const CandidateListPart& p) { return p.reference_frames.size() == e_count; });
     lists.scratch.resize(3, n);
@@ -703,6 +703,7 @@ void prepare_candidate_lists(Garment& g, GarmentSolver& solver) {
     lists.bits.assign(static_cast<std::size_t>(n), 0);
     lists.reference_x.resize(3, n);
     lists.clearance_m.setConstant(n, static_cast<Eigen::Index>(e_count), std::numeric_limits<Real>::infinity());
+    lists.min_clearance_m.setConstant(n, std::numeric_limits<Real>::infinity());
     lists.valid = true;
     ++g.counters.list_rebuilds;
 }
@@ -769,30 +770,44 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
         }
         if (bounds.empty())
             for (const auto [first, n] : runs) bounds.emplace_back(lists.reference_x, first, n);
-        for (std::size_t r = 0; r < runs.size(); ++r)
-            tests += refresh_bit(lists.reference_x, runs[r].begin, runs[r].end, bounds[r], ListEllipsoid(current), e, margin,
-                                 lists.bits, clearance.col(static_cast<Eigen::Index>(e)).data());
+        for (std::size_t r = 0; r < runs.size(); ++r) {
+            const auto [first, n] = runs[r];
+            tests += refresh_bit(lists.reference_x, first, n, bounds[r], ListEllipsoid(current), e, margin, lists.bits,
+                                 clearance.col(static_cast<Eigen::Index>(e)).data());
+            auto least = lists.min_clearance_m.segment(first, n - first);
+            least = least.cwiseMin(clearance.col(static_cast<Eigen::Index>(e)).segment(first, n - first));
+        }
         then = now;
     }
 
     // 3. Particles: a list is exact while d_p + D_e < C_pe for every unlisted e, the
-    //    clearance between their references: the slack is min_e (C_pe - D_e) - d_p, whole
-    //    columns. A particle without slack becomes its own reference and is tested against
-    //    every reference ellipsoid.
+    //    clearance between their references: the slack is min_e (C_pe - D_e) - d_p. First
+    //    its lower bound min_e C_pe - max_e D_e - d_p from the kept least clearance, one
+    //    column; where that is negative, the exact minimum (and the least clearance made
+    //    exact again). A particle without slack becomes its own reference and is tested
+    //    against every reference ellipsoid.
     const std::uint64_t active = active_mask(solver.frames);
+    Real most_moved = 0;
+    for_each_bit(active, [&](int e) { most_moved = std::max(most_moved, moved_since[static_cast<std::size_t>(e)]); });
     std::optional<ReferenceLanes> references;  // on first use
     alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
     std::vector<Eigen::Index>& spent = part.spent;
+    Real* least = lists.min_clearance_m.data();
     for (const auto [first, n] : runs) {
         const Eigen::Index count = n - first;
-        VectorX room = VectorX::Constant(count, std::numeric_limits<Real>::infinity());
-        for_each_bit(active, [&](int e) {
-            const Real* c = clearance.col(e).data() + first;
-            const Real moved = moved_since[static_cast<std::size_t>(e)];
-            Real* r = room.data();
-            for (Eigen::Index p = 0; p < count; ++p) r[p] = std::min(r[p], c[p] - moved);
-        });
-        slack.segment(first, count) = room - slack.segment(first, count);
+        for (Eigen::Index p = first; p < n; ++p) slack[p] = least[p] - most_moved - slack[p];  // slack held d_p
+        for (Eigen::Index p = first; p < n; ++p) {
+            if (slack[p] >= 0) continue;
+            Real room = std::numeric_limits<Real>::infinity(), exact = std::numeric_limits<Real>::infinity();
+            for_each_bit(active, [&](int e) {
+                const Real c = clearance(p, e);
+                room = std::min(room, c - moved_since[static_cast<std::size_t>(e)]);
+                exact = std::min(exact, c);
+            });
+            least[p] = exact;
+            const auto d = local.col(p) - lists.reference_x.col(p);
+            slack[p] = room - std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
         // The particles without slack, gathered without a branch per particle; pinned ones
         // are never tested (method §3.5).
         spent.resize(static_cast<std::size_t>(count));
@@ -817,7 +832,12 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
             lists.reference_x.col(p) = local.col(p);
             Real left = 0;
             lists.bits[static_cast<std::size_t>(p)] = references->test(local.col(p), margin, stored, left);
-            for (std::size_t e = 0; e < e_count; ++e) clearance(p, static_cast<Eigen::Index>(e)) = stored[e];
+            Real exact = std::numeric_limits<Real>::infinity();
+            for (std::size_t e = 0; e < e_count; ++e) {
+                clearance(p, static_cast<Eigen::Index>(e)) = stored[e];
+                exact = std::min(exact, stored[e]);
+            }
+            least[p] = exact;
             slack[p] = std::max(Real(0), left);
             tests += static_cast<std::uint64_t>(std::popcount(active));
         }

@@ -46,7 +46,8 @@ struct CandidateLists {
     Matrix3XRows reference_x;                ///< Per particle: its reference point (anchor frame), where its whole list was last refreshed.
     std::vector<CandidateListPart> parts;    ///< Per particle range of GarmentSolver::parts.
     Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic> clearance_m; ///< Particle x collider: clearance of the particle's reference point from the collider's reference pose, +inf when listed or inactive, m.
-    VectorX slack_m;                         ///< Per particle: how far it may still move before its list could miss a collider, after the last update, m.
+    VectorX min_clearance_m;                 ///< Per particle: at most its least clearance over the colliders (a bound kept cheaply: lowered when a collider is refreshed, exact again when the particle's slack is), m.
+    VectorX slack_m;                         ///< Per particle: how far it may still move before its list could miss a collider, after the last update (at most that), m.
     Matrix3XRows scratch;                    ///< Anchor-frame positions, reused every substep.
 };
 
