@@ -305,7 +305,17 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
 
     const int n = s.warp_lines, m = s.particles_per_line;
     const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;
-    const Real step = s.length_m / Real(m - 1);
+    // The hem above the ankles: a dress made for one body must not reach into the feet (or
+    // through the floor) of a shorter one.
+    Real length = s.length_m;
+    if (s.hem_clearance_fraction > 0) {
+        const Real drop = ring_y - (bottom + s.hem_clearance_fraction * height);
+        if (drop <= 0)
+            return fail(p + ".hem_clearance_fraction: the ring at " + number(ring_y - bottom) + " m is not above the hem's lowest height " +
+                        number(s.hem_clearance_fraction * height) + " m");
+        length = std::min(length, drop / std::cos(flare_rad));
+    }
+    const Real step = length / Real(m - 1);
     Matrix3X grid(3, n * m);
     for (int line = 0; line < n; ++line) {
         const Real theta = Real(2) * std::numbers::pi_v<Real> * Real(line) / Real(n);

@@ -50,6 +50,7 @@ struct TubeParams {
     int particles_per_line = 31;      ///< Particles down each line (m). 27 x 31 = 837.
     int weft_stride = 3;              ///< Every weft_stride-th line is layer 1 (method §3.2).
     Real length_m = Real(0.55);       ///< Along the cone from the ring to the hem.
+    Real hem_clearance_fraction = Real(0.09);  ///< The hem stays at least this x body height above the body's lowest point (the ankles): on a shorter body the garment is shortened (0: no limit).
     Real flare_deg = Real(18);        ///< Cone half-angle from vertical.
     Real ease_m = Real(0.01);         ///< Gap between the body outline at the ring and the cloth.
     RingPlace ring_at = RingPlace::waist;  ///< Where the ring sits on a character with BodyLandmarks.

@@ -117,6 +117,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
         integer("weft_stride", &TubeParams::weft_stride, closed(1, max_side - 1),
                 "every n-th line is integrated, the lines between are placed (method §3.2); less than `warp_lines`"),
         real("length_m", &TubeParams::length_m, open_min(0, 10), "m", "from the ring to the hem, along the cloth"),
+        real("hem_clearance_fraction", &TubeParams::hem_clearance_fraction, open_max(0, 1), "",
+             "the hem stays at least this x body height above the body's lowest point: `length_m` is shortened on a shorter body (0: never)"),
         real("flare_deg", &TubeParams::flare_deg, closed(0, 80), "deg", "cone half-angle from vertical"),
         real("ease_m", &TubeParams::ease_m, closed(0, 1), "m", "gap between the body outline at the ring and the cloth"),
         real("ring_height_fraction", &TubeParams::ring_height_fraction, open_max(0, 1), "",

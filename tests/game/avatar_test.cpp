@@ -457,16 +457,17 @@ TEST(AvatarBuilds, FittedEllipsoidsHugShortWideAndLongLeggedBodies) {
     }
 }
 
-// The skirt and the dress on the wide and the long-legged build, 600 frames of their walk,
-// after every frame: the contract asked of characters the team did not tune for (strain p99
-// <= 10 %, max <= 20 %, nothing left inside after the frame beyond 2 mm, pins outside).
-// Measured: skirt max 7.7 % (wide) and 7.5 % (long-legged), dress 10.0 % on both. The short
-// build misses it (skirt 45 %, its hem caught round a shin; dress 211 % in its first frame,
-// its hem starting inside a foot: docs/cloth.md, "Known limits").
-TEST(AvatarBuilds, SkirtAndDressHoldTheContractOnTheWideAndLongLeggedBuilds) {
+// The skirt and the dress on the wide, the long-legged and the short build, 600 frames of
+// their walk, after every frame: the contract asked of characters the team did not tune for
+// (strain p99 <= 10 %, max <= 20 %, nothing left inside after the frame beyond 2 mm, pins
+// outside). Measured: skirt max 7.7 % (wide) and 7.5 % (long-legged), dress 10.0 % on all
+// three (on the short build the dress is shortened to clear the ankles). The skirt on the
+// short build misses it (45 % in one frame, its hem caught round a shin: docs/cloth.md,
+// "Known limits").
+TEST(AvatarBuilds, SkirtAndDressHoldTheContractOnTheUnusualBuilds) {
     for (const auto& [name, model] : unusual_builds()) {
-        if (name == "short") continue;
         for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+            if (name == "short" && type == GarmentType::skirt) continue;
             const std::string garment = type == GarmentType::skirt ? "skirt" : "dress";
             SCOPED_TRACE(name + ", " + garment);
             const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / ("avatar_build_" + garment + "_" + name + ".glb");

@@ -1,7 +1,7 @@
 // Where a garment is put on: a skirt's fitting ring at the character's waist, a dress's
 // just under its arms (the body's landmarks), on the default avatar and, when present,
 // on a third-party character whose pelvis is found by topology; a set height overrides;
-// the pinned points stay outside the ellipsoids.
+// the pinned points stay outside the ellipsoids; a long dress is shortened on a short body.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,6 +10,7 @@
 #include "components/garment.hpp"
 #include "components/skeleton.hpp"
 #include "components/transform.hpp"
+#include "game/avatar_generator.hpp"
 #include "game/sample_scene.hpp"
 #include "game/world.hpp"
 #include "systems/character/body_landmarks.hpp"
@@ -85,6 +86,51 @@ TEST(GarmentPlacement, SkirtAtTheWaistOfAThirdPartyCharacter) {
     DRAPE_REQUIRE_SHARED(file);
     const Placed skirt = place(file, GarmentType::skirt);
     expect_at(skirt.ring_y, skirt.waist_y);
+}
+
+// Lowest and highest particle of the garment as built (world space, the walk's first pose)
+// and the body's height; `clearance` < 0 keeps the shipped hem_clearance_fraction.
+struct Hem {
+    Real low = 0, high = 0, height = 0;
+};
+
+Hem hem(const fs::path& file, GarmentType type, double clearance = -1) {
+    SceneDescription scene = sample_scene();
+    scene.characters.at(0).file = file;
+    scene.garments.at(0).type = type;
+    if (clearance >= 0) scene.garments.at(0).parameters.push_back({"hem_clearance_fraction", clearance});
+    auto world = build_world(scene, {});
+    EXPECT_TRUE(world) << (world ? "" : world.error().message);
+    Hem out;
+    if (!world) return out;
+    const Garment& g = world->registry.get<Garment>(world->garments.at(0));
+    out.low = g.state.x.row(1).minCoeff();
+    out.high = g.state.x.row(1).maxCoeff();
+    const auto* l = world->registry.try_get<BodyLandmarks>(world->characters.at(0));
+    EXPECT_NE(l, nullptr);
+    if (l) out.height = l->height_m * world->registry.get<Transform>(world->characters.at(0)).scale;
+    return out;
+}
+
+// The dress (1.05 m from under the arms) keeps its length on the default avatar, whose hem
+// hangs 19 cm above the floor; on a 1.2 m body it would reach 18 cm below the floor, into
+// the feet, so it is shortened to hang 9 % of the body's height above its lowest point
+// (less the walk's first pose, a centimetre or two).
+TEST(GarmentPlacement, ALongDressIsShortenedOnAShortBody) {
+    const fs::path avatar = sample_scene().characters.at(0).file;
+    const Hem tall = hem(avatar, GarmentType::dress), tall_unlimited = hem(avatar, GarmentType::dress, 0);
+    EXPECT_EQ(tall.low, tall_unlimited.low) << "the default avatar's dress is not shortened";
+    EXPECT_GT(tall.low, Real(0.09) * tall.height);
+    AvatarOptions options;
+    options.height_m = 1.2;
+    const fs::path small = fs::path(DRAPE_BINARY_DIR) / "garment_placement_short.glb";
+    ASSERT_TRUE(write_avatar(make_default_avatar(options), small));
+    const Hem shortened = hem(small, GarmentType::dress), unlimited = hem(small, GarmentType::dress, 0);
+    fs::remove(small);
+    EXPECT_NEAR(shortened.height, 1.2f, 0.05f);
+    EXPECT_LT(unlimited.low, 0) << "without the clearance the dress reaches through the floor";
+    EXPECT_GT(shortened.low, Real(0.09) * shortened.height - Real(0.03));
+    EXPECT_NEAR(shortened.high, unlimited.high, 1e-3f) << "the ring stays where it was";
 }
 
 // Fitting-zone points sit on or outside the ellipsoids after every frame of the walk, also
