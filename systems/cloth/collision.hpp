@@ -16,7 +16,9 @@
 //      contain it. An ellipsoid that has moved half the margin gets its bit (and C_pe)
 //      refreshed in every list (a fast shin often, the pelvis rarely; blocks of particles
 //      whose box is far from it are cleared untested); a particle with no slack left,
-//      min_e (C_pe - D_e) - d_p, gets its whole list refreshed. The slack is kept for step 3.
+//      min_e (C_pe - D_e) - d_p, gets its whole list refreshed. The slack is first taken
+//      from a kept lower bound of min_e C_pe less the largest D_e, and exactly only where
+//      that bound runs out. The slack (at most the exact one) is kept for step 3.
 //      A garment cut into bands (garment_parts.hpp) keeps the ellipsoid references per band,
 //      so that bands are brought up to date independently, on different threads.
 //   2. Detection: in list mode 64 consecutive particles are tested at once against every
