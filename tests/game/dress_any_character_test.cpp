@@ -1,7 +1,8 @@
 // Dressing characters no one here made, as a new user would through a scene description:
 // the third-party characters in ../shared/assets/characters, each in a skirt and in a
 // dress. The garment must sit on the body (around its hips), no free particle may end
-// inside an ellipsoid, and nothing may go non-finite.
+// inside an ellipsoid, and nothing may go non-finite; on Male_Casual and RobotExpressive
+// both garments hold the after-frame contract asked of such characters.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"
+#include "game/stats.hpp"
 #include "game/world.hpp"
 #include "tests/shared_assets.hpp"
 
@@ -100,6 +102,37 @@ void dress_and_walk(const Character& c, GarmentType type) {
     ASSERT_GT(pinned, 0);
     EXPECT_LT(centre.y(), ring.y() / Real(pinned));
     EXPECT_EQ(run_stats(*world).garments.at(0).nonfinite, 0u);
+}
+
+// 300 frames of the walk the importer picks, after every frame: strain p99 <= 10 %, max
+// <= 20 %, nothing inside after the frame beyond 2 mm, pins outside. Measured: skirt 9.9 %
+// and 15.4 %, dress 10.0 % on both (RobotExpressive's dress shortened to clear its feet,
+// and settled from its first pose by contact repair). Female_Alternative misses it
+// (docs/cloth.md, "Known limits").
+TEST(DressAnyCharacter, SkirtAndDressHoldTheContractOnMaleCasualAndRobotExpressive) {
+    for (const Character& c : {characters[0], characters[1]}) {
+        const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
+        DRAPE_REQUIRE_SHARED(file);
+        for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+            SCOPED_TRACE(std::string(c.file) + (type == GarmentType::skirt ? ", skirt" : ", dress"));
+            SceneDescription scene;
+            scene.characters.emplace_back();
+            scene.characters[0].file = file;
+            scene.characters[0].in_place = true;
+            scene.garments.emplace_back();
+            scene.garments[0].type = type;
+            auto world = build_world(scene, {});
+            ASSERT_TRUE(world) << world.error().message;
+            for (int frame = 0; frame < 300; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+            const GarmentStats g = run_stats(*world).garments.at(0);
+            EXPECT_LE(g.strain_p99, 0.10);
+            EXPECT_LE(g.strain_max, 0.20);
+            EXPECT_LE(g.penetration_after_frame_m, 2e-3);
+            EXPECT_LE(g.pins_inside_m, 5e-3);
+            EXPECT_EQ(g.nonfinite, 0u);
+            EXPECT_EQ(g.resets, 0u);
+        }
+    }
 }
 
 TEST(DressAnyCharacter, MaleCasualInASkirt) { dress_and_walk(characters[0], GarmentType::skirt); }
