@@ -284,6 +284,25 @@ TEST(Robustness, ResetPutsTheGarmentBackAtRestAroundTheBodyWhereItIsNow) {
     EXPECT_EQ(g.counters.resets, 1u);
 }
 
+// Contact repair's larger first-step budget (garment_step.cpp) is for the first fixed step
+// after the build and after a reset, not for the steps of a walk.
+TEST(Robustness, OnlyTheFirstStepAfterTheBuildOrAResetSettles) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, TubeParams::skirt());
+    const GarmentSolver& solver = scene.registry.get<GarmentSolver>(e);
+    scene.run(1);
+    EXPECT_TRUE(solver.settling);
+    scene.run(1);
+    EXPECT_FALSE(solver.settling);
+    scene.run(10);
+    EXPECT_FALSE(solver.settling);
+    reset_garment(scene.registry, e);
+    scene.run(1);
+    EXPECT_TRUE(solver.settling);
+    scene.run(1);
+    EXPECT_FALSE(solver.settling);
+}
+
 // Several avatars at different phases, simulated with one or two threads.
 Matrix3X simulate_crowd(int threads, int avatars, int frames) {
     tbb::global_control control(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
