@@ -13,6 +13,7 @@
 #include "components/garment.hpp"
 #include "game/stats.hpp"
 #include "game/world.hpp"
+#include "tests/game/character_contract.hpp"
 #include "tests/shared_assets.hpp"
 
 namespace drape {
@@ -130,12 +131,7 @@ TEST(DressAnyCharacter, GarmentsHoldTheContractOnMaleCasualAndRobotExpressive) {
         ASSERT_TRUE(world) << world.error().message;
         for (int frame = 0; frame < 300; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
         const GarmentStats g = run_stats(*world).garments.at(0);
-        EXPECT_LE(g.strain_p99, 0.10);
-        EXPECT_LE(g.strain_max, 0.20);
-        EXPECT_LE(g.penetration_after_frame_m, 2e-3);
-        EXPECT_LE(g.pins_inside_m, 5e-3);
-        EXPECT_EQ(g.nonfinite, 0u);
-        EXPECT_EQ(g.resets, 0u);
+        test::expect_character_contract(g);
     }
 }
 
