@@ -239,18 +239,8 @@ VectorX weft_rest_right(const Fabric& f) {
 
 namespace {
 
-// Scratch of one weft row's limit, sized for the fabric's rows.
-struct WeftRowScratch {
-    std::vector<std::uint32_t> p;
-    std::vector<Vec3> dir;
-    std::vector<Real> excess, diag, upper, dl, sweep;
-    std::vector<char> dirty;
-    WeftRowScratch(std::uint32_t lines, std::uint32_t springs)
-        : p(lines), dir(springs), excess(springs), diag(springs), upper(springs), dl(springs), sweep(springs), dirty(springs) {}
-};
-
 std::uint64_t limit_weft_row(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real scale, Matrix3X& x,
-                             Matrix3X& moves, std::uint32_t row, WeftRowScratch& scratch) {
+                             Matrix3X& moves, std::uint32_t row, WeftLimitScratch& scratch) {
     const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
     const std::uint32_t springs = f.closed ? n : n - 1;
     auto& [p, dir, excess, diag, upper, dl, sweep, dirty] = scratch;
@@ -327,11 +317,23 @@ std::uint64_t limit_weft_row(const Fabric& f, const VectorX& rest_right, const V
     return corrected;
 }
 
+// The scratch sized for the fabric's rows: `given`, or a local one.
+WeftLimitScratch& sized(const Fabric& f, WeftLimitScratch* given, WeftLimitScratch& local) {
+    WeftLimitScratch& s = given != nullptr ? *given : local;
+    const std::uint32_t lines = f.warp_lines, springs = f.closed ? f.warp_lines : f.warp_lines - 1;
+    s.p.resize(lines);
+    for (auto* v : {&s.excess, &s.diag, &s.upper, &s.dl, &s.sweep}) v->resize(springs);
+    s.dir.resize(springs);
+    s.dirty.resize(springs);
+    return s;
+}
+
 }  // namespace
 
 std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real stretch, Matrix3X& x,
-                              Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row) {
-    WeftRowScratch scratch(f.warp_lines, f.closed ? f.warp_lines : f.warp_lines - 1);
+                              Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row, WeftLimitScratch* given) {
+    WeftLimitScratch local;
+    WeftLimitScratch& scratch = sized(f, given, local);
     std::uint64_t corrected = 0;
     for (std::uint32_t row = first_row; row < end_row; ++row)
         corrected += limit_weft_row(f, rest_right, w, 1 + stretch, x, moves, row, scratch);
@@ -339,8 +341,9 @@ std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const 
 }
 
 std::uint64_t limit_weft_rows(const Fabric& f, const VectorX& rest_right, const VectorX& w, Real stretch, Matrix3X& x,
-                              Matrix3X& moves, std::span<const std::uint32_t> rows) {
-    WeftRowScratch scratch(f.warp_lines, f.closed ? f.warp_lines : f.warp_lines - 1);
+                              Matrix3X& moves, std::span<const std::uint32_t> rows, WeftLimitScratch* given) {
+    WeftLimitScratch local;
+    WeftLimitScratch& scratch = sized(f, given, local);
     std::uint64_t corrected = 0;
     for (const std::uint32_t row : rows) corrected += limit_weft_row(f, rest_right, w, 1 + stretch, x, moves, row, scratch);
     return corrected;

@@ -116,6 +116,15 @@ std::uint64_t limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, 
 inline constexpr int weft_limit_passes = 3;
 inline constexpr Real weft_limit_tolerance = Real(0.01);
 
+/// What limit_weft_rows works in, per weft spring of a row (sized on each call; keeping one
+/// per thread spares the allocations).
+struct WeftLimitScratch {
+    std::vector<std::uint32_t> p;
+    std::vector<Vec3> dir;
+    std::vector<Real> excess, diag, upper, dl, sweep;
+    std::vector<char> dirty;
+};
+
 /// After the rounds, with the warp limit: Provot's limit along every weft row [first_row,
 /// end_row) at once (an extension of method §4.1). Where a spring of a row is longer than
 /// (1 + stretch) x rest by more than weft_limit_tolerance x rest, every run of neighbouring
@@ -124,11 +133,14 @@ inline constexpr Real weft_limit_tolerance = Real(0.01);
 /// shared by inverse mass (a pinned end stays). A few passes (weft_limit_passes) take up
 /// what the linearisation leaves. Rows are independent of each other. `moves` receives
 /// each particle of the rows' move (zero for the rest). Returns the spring corrections made.
+/// `scratch` null: a local one.
 std::uint64_t limit_weft_rows(const Fabric& fabric, const VectorX& rest_right, const VectorX& inv_mass, Real stretch,
-                              Matrix3X& x, Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row);
+                              Matrix3X& x, Matrix3X& moves, std::uint32_t first_row, std::uint32_t end_row,
+                              WeftLimitScratch* scratch = nullptr);
 
 /// The same on the rows listed, in their order.
 std::uint64_t limit_weft_rows(const Fabric& fabric, const VectorX& rest_right, const VectorX& inv_mass, Real stretch,
-                              Matrix3X& x, Matrix3X& moves, std::span<const std::uint32_t> rows);
+                              Matrix3X& x, Matrix3X& moves, std::span<const std::uint32_t> rows,
+                              WeftLimitScratch* scratch = nullptr);
 
 }  // namespace drape

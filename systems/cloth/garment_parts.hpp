@@ -23,6 +23,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
+#include <tbb/global_control.h>
 
 #include "components/garment.hpp"
 #include "engine/core/math.hpp"
@@ -63,12 +64,13 @@ struct GarmentParts {
 /// for the classic), `integrated` the particles [0, integrated) integrated.
 [[nodiscard]] GarmentParts make_parts(const Fabric& fabric, ClothModel model, Eigen::Index integrated);
 
-/// Calls f(k) for every part k in [0, count): on the calling thread for one part, else as
-/// TBB tasks (one part each) on the threads TBB has, returning when all are done.
+/// Calls f(k) for every part k in [0, count): in order on the calling thread for one part
+/// or when TBB may use one thread (tbb::global_control), else as TBB tasks (one part each) on the threads TBB has,
+/// returning when all are done.
 template <class F>
 void for_each_part(std::size_t count, F&& f) {
-    if (count == 1) {
-        f(std::size_t(0));
+    if (count == 1 || tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) == 1) {
+        for (std::size_t k = 0; k < count; ++k) f(k);
         return;
     }
     tbb::parallel_for(

@@ -103,6 +103,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             }
         s.part_counters.assign(parts.count, PartCounters{});
         s.pushed.assign(parts.count, {});
+        s.part_scratch.resize(parts.count);
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);
         s.built_for = g.config;
         s.built_fabric = &t;

@@ -60,6 +60,15 @@ struct PartCounters {
     bool finite = true;
 };
 
+/// One part's scratch for the stages after the rounds (garment_step.cpp): its weft rows'
+/// limit, and its share of contact repair's rounds.
+struct PartScratch {
+    WeftLimitScratch weft;
+    std::vector<std::uint32_t> rows, lines;  ///< Repair: rows and lines its particles chose.
+    std::vector<std::uint32_t> moved;        ///< Repair: its particles that moved (collided again next).
+    std::vector<std::uint64_t> touched;      ///< Per particle of `moved`: its last_collided before that collision.
+};
+
 struct GarmentSolver {
     GarmentConfig built_for;                 ///< The configuration the caches below were made for.
     const Fabric* built_fabric = nullptr;    ///< And the fabric.
@@ -105,8 +114,8 @@ struct GarmentSolver {
     Matrix3X repair_weft_moves;              ///< Per particle: the weft limit's move in the current repair round.
     VectorX repair_inv_mass;                 ///< The limits' inverse masses in the repair rounds (pushed particles heavier).
     std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
-    std::vector<std::uint32_t> repair_rows, repair_lines, repair_moved; ///< The repair rounds' choices.
-    std::vector<std::uint64_t> repair_touched; ///< Per particle of repair_moved: its last_collided before a repair collision.
+    std::vector<std::uint32_t> repair_rows, repair_lines, repair_moved; ///< The repair rounds' choices, all parts'.
+    std::vector<PartScratch> part_scratch;   ///< Per part.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.
 };
 

@@ -172,7 +172,8 @@ void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep&) {
     for_each_part(parts, [&](std::size_t k) {
         const auto first_row = static_cast<std::uint32_t>(rows * k / parts), end_row = static_cast<std::uint32_t>(rows * (k + 1) / parts);
         s.part_counters[k].weft_moved =
-            limit_weft_rows(*g.fabric, s.weft_rest_right, s.inv_mass, stretch, g.state.x, s.weft_moves, first_row, end_row);
+            limit_weft_rows(*g.fabric, s.weft_rest_right, s.inv_mass, stretch, g.state.x, s.weft_moves, first_row, end_row,
+                            &s.part_scratch[k].weft);
     });
 }
 
@@ -279,31 +280,45 @@ int over_limit(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::
     return springs;
 }
 
-// The particles listed (moved after the lists were last brought up to date) collided again,
-// positions only, each against every active ellipsoid (they are few and scattered: no list,
-// no blocks); the particles pushed go to s.pushed[0], the other parts' lists are emptied.
-void collide_moved(Garment& g, GarmentSolver& s, std::span<const std::uint32_t> moved) {
-    for (std::vector<std::uint32_t>& part : s.pushed) part.clear();
+// Part `part`'s particles in s.part_scratch[part].moved (moved after the lists were last
+// brought up to date) collided again, positions only, each against every active ellipsoid
+// (they are few and scattered: no list, no blocks); the particles pushed go to
+// s.pushed[part]. A particle and the one above it on its line are in the same part.
+void collide_moved(Garment& g, GarmentSolver& s, std::size_t part) {
+    PartScratch& ps = s.part_scratch[part];
+    std::vector<std::uint32_t>& pushed = s.pushed[part];
+    pushed.clear();
+    if (ps.moved.empty()) return;  // (collide_particles takes an empty list as every particle)
     Matrix3X& x = g.state.x;
-    s.repair_touched.resize(moved.size());
+    const std::span<const std::uint32_t> moved = ps.moved;
+    ps.touched.resize(moved.size());
     for (std::size_t k = 0; k < moved.size(); ++k) {
         s.x_round.col(moved[k]) = x.col(moved[k]);
-        s.repair_touched[k] = s.last_collided[moved[k]];
+        ps.touched[k] = s.last_collided[moved[k]];
     }
     const CollisionResult r = collide_particles(x, g.state.v, g.state.inv_mass, s.frames, nullptr, s.last_collided, nullptr,
                                                 g.config.material.friction, {}, 0, -1, /*respond_velocity=*/false, s.above, moved);
-    PartCounters& c = s.part_counters.front();
+    PartCounters& c = s.part_counters[part];
     c.collision_tests += r.tests;
     c.collisions += r.collisions;
     c.max_penetration_m = std::max(c.max_penetration_m, r.max_penetration_m);
     for (std::size_t k = 0; k < moved.size(); ++k) {
         const std::uint32_t p = moved[k];
         s.contacts[p] |= s.last_collided[p];
-        s.last_collided[p] |= s.repair_touched[k];  // the last round's contacts stay
+        s.last_collided[p] |= ps.touched[k];  // the last round's contacts stay
         if (x.col(p) == s.x_round.col(p)) continue;
         s.push.col(p) += x.col(p) - s.x_round.col(p);
-        s.pushed.front().push_back(p);
+        pushed.push_back(p);
     }
+}
+
+// The parts' lists in `out`, sorted, each once.
+void merge_sorted(std::vector<std::uint32_t>& out, const std::vector<PartScratch>& parts,
+                  std::vector<std::uint32_t> PartScratch::*list) {
+    out.clear();
+    for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
 // Contact repair (an extension of method §4.1-§5, docs/cloth.md "Contact repair"): the last
@@ -315,70 +330,84 @@ void collide_moved(Garment& g, GarmentSolver& s, std::span<const std::uint32_t> 
 // pushed_weight) so that the limits move its neighbours toward it rather than it back into
 // the body; then what they moved is collided again. Until no spring of a moved particle is
 // over the limit, or repair_rounds rounds (settling_repair_rounds in the first step).
+// Each stage of a round runs in parts at the same time, on particles no other part touches:
+// the choice by the particles' bands, the warp limit by the lines' bands, the weft limit on
+// a share of the rows, the collision by the particles' bands; what the parts chose or moved
+// is merged in index order between the stages, so the result is the same on any number of
+// threads.
 void repair_pushes(Garment& g, GarmentSolver& s) {
     const Fabric& f = *g.fabric;
     const std::uint32_t m = f.particles_per_line;
     const Real limit = g.config.material.strain_limit;
     const Real stretch = limit_share * limit;
+    const std::size_t parts = s.parts.count;
     Matrix3X& x = g.state.x;
-    std::vector<std::uint32_t>& rows = s.repair_rows;
-    std::vector<std::uint32_t>& lines = s.repair_lines;
     // Moved by the last limits: first, those the weft limit moved. The warp limit leaves no
     // warp spring over its bound and the weft limit then checks every weft spring, so a
     // spring over the limit after both has an end the weft limit moved (a row it did not
     // settle in its passes, or a warp spring its sideways move stretched).
-    std::vector<std::uint32_t>& moved = s.repair_moved;
-    moved.clear();
-    for (Eigen::Index p = 0; p < x.cols(); ++p)
-        if (s.weft_moves.col(p).squaredNorm() > 0) moved.push_back(static_cast<std::uint32_t>(p));
-    bool weighted = false;  // repair_inv_mass holds this substep's weights
-    const auto weights = [&]() -> VectorX& {
-        if (!weighted) s.repair_inv_mass = s.inv_mass;
-        weighted = true;
-        return s.repair_inv_mass;
-    };
+    for_each_part(parts, [&](std::size_t k) {
+        std::vector<std::uint32_t>& moved = s.part_scratch[k].moved;
+        moved.clear();
+        for (const auto [first, end] : s.parts.runs[k])
+            for (Eigen::Index p = first; p < end; ++p)
+                if (s.weft_moves.col(p).squaredNorm() > 0) moved.push_back(static_cast<std::uint32_t>(p));
+    });
+    s.repair_inv_mass = s.inv_mass;  // the pushed particles chosen are made heavier below
+    const VectorX& w = s.repair_inv_mass;
     const int rounds = s.settling ? settling_repair_rounds : repair_rounds;
     for (int round = 0; round < rounds; ++round) {
-        rows.clear();
-        lines.clear();
-        const auto choose = [&](std::uint32_t p) {
-            const int springs = over_limit(f, s, x, p, limit);
-            if (springs & 1) lines.push_back(s.grid_place[p] / m);
-            if (springs & 2) rows.push_back(s.grid_place[p] % m);
-            return springs != 0;
-        };
-        for (const std::vector<std::uint32_t>& part : s.pushed)
-            for (const std::uint32_t p : part)
-                if (choose(p)) weights()[p] = s.inv_mass[p] * pushed_weight;
-        for (const std::uint32_t p : moved) choose(p);
-        if (rows.empty() && lines.empty()) return;
-        std::sort(rows.begin(), rows.end());
-        rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-        std::sort(lines.begin(), lines.end());
-        lines.erase(std::unique(lines.begin(), lines.end()), lines.end());
-        const VectorX& w = weights();
-        for (const std::uint32_t line : lines) {
-            limit_warp_lines(f, s.warp_rest_above, w, stretch, x, s.repair_warp_moves, line, line + 1);
-            for (std::uint32_t row = 0; row < m; ++row) {
-                const std::uint32_t p = f.grid[line * m + row];
-                s.warp_moves.col(p) += s.repair_warp_moves.col(p);  // given back to the leader's velocity
-            }
-        }
-        limit_weft_rows(f, s.weft_rest_right, w, stretch, x, s.repair_weft_moves, rows);
-        // What the limits moved is collided again and looked at in the next round; the
-        // moves go back to zero.
-        moved.clear();
-        const auto take = [&](Matrix3X& moves, std::uint32_t p) {
+        for_each_part(parts, [&](std::size_t k) {
+            PartScratch& ps = s.part_scratch[k];
+            ps.rows.clear();
+            ps.lines.clear();
+            const auto choose = [&](std::uint32_t p) {
+                const int springs = over_limit(f, s, x, p, limit);
+                if (springs & 1) ps.lines.push_back(s.grid_place[p] / m);
+                if (springs & 2) ps.rows.push_back(s.grid_place[p] % m);
+                return springs != 0;
+            };
+            for (const std::uint32_t p : s.pushed[k])
+                if (choose(p)) s.repair_inv_mass[p] = s.inv_mass[p] * pushed_weight;
+            for (const std::uint32_t p : ps.moved) choose(p);
+        });
+        merge_sorted(s.repair_rows, s.part_scratch, &PartScratch::rows);
+        merge_sorted(s.repair_lines, s.part_scratch, &PartScratch::lines);
+        if (s.repair_rows.empty() && s.repair_lines.empty()) return;
+        // What the limits move is collided again and looked at in the next round; the moves
+        // go back to zero.
+        const auto take = [](Matrix3X& moves, std::uint32_t p, std::vector<std::uint32_t>& moved) {
             if (moves.col(p).squaredNorm() > 0) moved.push_back(p);
             moves.col(p).setZero();
         };
-        for (const std::uint32_t line : lines)
-            for (std::uint32_t row = 0; row < m; ++row) take(s.repair_warp_moves, f.grid[line * m + row]);
-        for (const std::uint32_t row : rows)
-            for (std::uint32_t line = 0; line < f.warp_lines; ++line) take(s.repair_weft_moves, f.grid[line * m + row]);
-        std::sort(moved.begin(), moved.end());  // in index order, once each
-        moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
-        collide_moved(g, s, moved);
+        for_each_part(parts, [&](std::size_t k) {
+            PartScratch& ps = s.part_scratch[k];
+            ps.moved.clear();
+            const auto [first_line, end_line] = s.parts.lines[k];
+            for (const std::uint32_t line : s.repair_lines) {
+                if (line < first_line || line >= end_line) continue;
+                limit_warp_lines(f, s.warp_rest_above, w, stretch, x, s.repair_warp_moves, line, line + 1);
+                for (std::uint32_t row = 0; row < m; ++row) {
+                    const std::uint32_t p = f.grid[line * m + row];
+                    s.warp_moves.col(p) += s.repair_warp_moves.col(p);  // given back to the leader's velocity
+                    take(s.repair_warp_moves, p, ps.moved);
+                }
+            }
+        });
+        const std::size_t row_count = s.repair_rows.size();
+        for_each_part(parts, [&](std::size_t k) {
+            PartScratch& ps = s.part_scratch[k];
+            const std::span<const std::uint32_t> rows =
+                std::span<const std::uint32_t>(s.repair_rows).subspan(row_count * k / parts, row_count * (k + 1) / parts - row_count * k / parts);
+            limit_weft_rows(f, s.weft_rest_right, w, stretch, x, s.repair_weft_moves, rows, &ps.weft);
+            for (const std::uint32_t row : rows)
+                for (std::uint32_t line = 0; line < f.warp_lines; ++line) take(s.repair_weft_moves, f.grid[line * m + row], ps.moved);
+        });
+        // Once each, in index order, each in its own band's part.
+        merge_sorted(s.repair_moved, s.part_scratch, &PartScratch::moved);
+        for (PartScratch& ps : s.part_scratch) ps.moved.clear();
+        for (const std::uint32_t p : s.repair_moved) s.part_scratch[s.parts.band[p]].moved.push_back(p);
+        for_each_part(parts, [&](std::size_t k) { collide_moved(g, s, k); });
     }
 }
 
