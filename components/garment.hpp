@@ -175,6 +175,7 @@ struct GarmentCounters {
     std::uint64_t collisions = 0;
     std::uint64_t list_rebuilds = 0;
     std::uint64_t list_rebuild_tests = 0;
+    std::uint64_t repair_rounds = 0;          ///< Contact repair rounds run (limits and collision after the last collision).
     std::uint64_t non_finite_values = 0;      ///< Non-finite coordinates found (then the garment was reset).
     std::uint64_t resets = 0;                 ///< Resets (non-finite state, or reset_garment()).
     std::uint64_t steps = 0;                  ///< Fixed steps simulated.

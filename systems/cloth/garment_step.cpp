@@ -374,6 +374,7 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
         merge_sorted(s.repair_rows, s.part_scratch, &PartScratch::rows);
         merge_sorted(s.repair_lines, s.part_scratch, &PartScratch::lines);
         if (s.repair_rows.empty() && s.repair_lines.empty()) return;
+        ++g.counters.repair_rounds;
         // What the limits move is collided again and looked at in the next round; the moves
         // go back to zero.
         const auto take = [](Matrix3X& moves, std::uint32_t p, std::vector<std::uint32_t>& moved) {

@@ -348,7 +348,7 @@ TEST(Determinism, OneOrTwoThreadsGiveIdenticalBytes) {
 // `threads` threads.
 struct DressRun {
     Matrix3X x, v;
-    std::uint64_t collision_tests = 0, collisions = 0, list_tests = 0;
+    std::uint64_t collision_tests = 0, collisions = 0, list_tests = 0, repair_rounds = 0;
     std::size_t parts = 0;
 };
 
@@ -363,13 +363,14 @@ DressRun simulate_dress(int threads, int frames) {
     for (int f = 0; f < frames; ++f) (void)scheduler.tick(registry, 1.0 / 60.0);
     const Garment& g = registry.get<Garment>(e);
     return {g.state.x, g.state.v, g.counters.collision_tests, g.counters.collisions, g.counters.list_rebuild_tests,
-            registry.get<GarmentSolver>(e).parts.count};
+            g.counters.repair_rounds, registry.get<GarmentSolver>(e).parts.count};
 }
 
 TEST(Determinism, ABigGarmentsOwnWorkOnOneTwoOrThreeThreadsGivesIdenticalBytes) {
     const DressRun one = simulate_dress(1, 40);
     ASSERT_GE(one.parts, 2u);  // the dress is cut into parts that threads take
     EXPECT_GT(one.collisions, 0u);
+    EXPECT_GT(one.repair_rounds, 0u);  // contact repair's rounds run in the parts too
     for (int threads : {2, 3}) {
         const DressRun many = simulate_dress(threads, 40);
         EXPECT_TRUE(same_bytes(one.x, many.x)) << threads << " threads";
@@ -377,6 +378,7 @@ TEST(Determinism, ABigGarmentsOwnWorkOnOneTwoOrThreeThreadsGivesIdenticalBytes) 
         EXPECT_EQ(one.collision_tests, many.collision_tests);
         EXPECT_EQ(one.collisions, many.collisions);
         EXPECT_EQ(one.list_tests, many.list_tests);
+        EXPECT_EQ(one.repair_rounds, many.repair_rounds);
     }
 }
 
