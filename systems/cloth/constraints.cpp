@@ -2,6 +2,7 @@
 #include "systems/cloth/constraints.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -134,15 +135,28 @@ void solve_springs(SpringSet& set, std::size_t band, Matrix3XRows& x, const Vect
     }
 }
 
-void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& w, Real h, Real limit) {
+namespace {
+
+// The edge springs of `set`, coordinate k of particle p at x[k] + p * stride.
+void solve_edge_strips(SpringSet& set, std::array<Real*, 3> x, std::ptrdiff_t stride, const VectorX& w, Real h, Real limit) {
     const Real inv_h2 = 1 / (h * h);
     const Real limit_scale = set.limited ? 1 + limit : std::numeric_limits<Real>::infinity();
     for (const SpringStrip& st : set.strips.edge) {  // one spring each: a lane of one
-        Real* a = x.col(st.a).data();
-        Real* b = x.col(st.b).data();
-        solve_strip<1>(1, a, a + 1, a + 2, b, b + 1, b + 2, w.data() + st.a, w.data() + st.b, set.springs->rest_m.data() + st.first,
-                       set.compliance.data() + st.first, set.lambda.data() + st.first, inv_h2, limit_scale);
+        const std::ptrdiff_t a = st.a * stride, b = st.b * stride;
+        solve_strip<1>(1, x[0] + a, x[1] + a, x[2] + a, x[0] + b, x[1] + b, x[2] + b, w.data() + st.a, w.data() + st.b,
+                       set.springs->rest_m.data() + st.first, set.compliance.data() + st.first, set.lambda.data() + st.first,
+                       inv_h2, limit_scale);
     }
+}
+
+}  // namespace
+
+void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& w, Real h, Real limit) {
+    solve_edge_strips(set, {x.data(), x.data() + 1, x.data() + 2}, 3, w, h, limit);
+}
+
+void solve_edge_springs(SpringSet& set, Matrix3XRows& x, const VectorX& w, Real h, Real limit) {
+    solve_edge_strips(set, {x.row(0).data(), x.row(1).data(), x.row(2).data()}, 1, w, h, limit);
 }
 
 VectorX warp_rest_above(const Fabric& f) {

@@ -71,8 +71,9 @@ struct SpringSet {
 void solve_springs(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
 
 /// The same for the springs of `set` that join two bands, on positions held one column per
-/// particle.
+/// particle or one row per coordinate (the same arithmetic).
 void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& inv_mass, Real h_s, Real limit);
+void solve_edge_springs(SpringSet& set, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
 
 /// Long-range attachments (step 2): one per free particle below a pinned one on its line.
 struct Tethers {

@@ -123,18 +123,31 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
     Matrix3X& x = g.state.x;
     const Real h = static_cast<Real>(sub.h_s);
     const Real limit = g.config.material.strain_limit;
-    const bool tethers = round + 1 == constraint_rounds(g);
+    const int rounds = constraint_rounds(g);
+    const bool tethers = round + 1 == rounds;
+    // The positions are held one row per coordinate (the strips run in vector lanes) from a
+    // round to the next when no collision round comes between them; x is written only
+    // before a collision round (and so after the last round).
+    const bool in_rows = round > 0 && !collides_after(round - 1, rounds);
+    const bool write_back = collides_after(round, rounds) || tethers;
     // The springs joining two bands first, on this thread (none in a garment of one band).
-    for (SpringSet& set : s.springs) solve_edge_springs(set, x, s.inv_mass, h, limit);
-    // Then band by band: positions in, one row per coordinate (the strips run in vector
-    // lanes), every set in order, in the last round the tethers, positions out.
+    for (SpringSet& set : s.springs) {
+        if (in_rows)
+            solve_edge_springs(set, s.x_rows, s.inv_mass, h, limit);
+        else
+            solve_edge_springs(set, x, s.inv_mass, h, limit);
+    }
+    // Then band by band: positions in, every set in order, in the last round the tethers,
+    // positions out.
     for_each_part(s.parts.count, [&](std::size_t k) {
-        for (const ParticleRun& r : s.parts.runs[k])
-            s.x_rows.middleCols(r.begin, r.end - r.begin) = x.middleCols(r.begin, r.end - r.begin);
+        if (!in_rows)
+            for (const ParticleRun& r : s.parts.runs[k])
+                s.x_rows.middleCols(r.begin, r.end - r.begin) = x.middleCols(r.begin, r.end - r.begin);
         for (SpringSet& set : s.springs) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
         if (tethers) solve_tethers(s.tethers[k], s.x_rows);
-        for (const ParticleRun& r : s.parts.runs[k])
-            x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);
+        if (write_back)
+            for (const ParticleRun& r : s.parts.runs[k])
+                x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);
     });
 }
 

@@ -57,7 +57,10 @@ void integrate_garment(const Registry& registry, Garment& garment, GarmentSolver
 void prepare_collision(const Registry& registry, Garment& garment, GarmentSolver& solver, const ClothSubstep& substep);
 
 /// One Gauss-Seidel round of springs with Provot's limit; in the last round then the tethers
-/// (constraints.hpp).
+/// (constraints.hpp). The rounds of a substep run in order, 0 first: between two rounds
+/// with no collision round between them the positions stay in solver.x_rows, and the
+/// garment's x is written only where a collision round follows (collides_after) and after
+/// the last round.
 void constrain_round(Garment& garment, GarmentSolver& solver, const ClothSubstep& substep, int round);
 
 /// One round of collision of every particle, positions only.
