@@ -116,6 +116,7 @@ struct GarmentSolver {
     std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
     std::vector<std::uint32_t> repair_rows, repair_lines, repair_moved; ///< The repair rounds' choices, all parts'.
     std::vector<PartScratch> part_scratch;   ///< Per part.
+    std::vector<std::uint32_t> weft_row_work; ///< Per weft row: springs the weft limit corrected in it last substep.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.
 };
 

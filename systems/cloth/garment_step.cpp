@@ -39,6 +39,10 @@ constexpr int repair_rounds = 48;
 constexpr int settling_repair_rounds = 192;
 constexpr Real pushed_weight = Real(0.1);
 
+// The weft limit's work in a row, for sharing the rows out between parts: a spring it
+// corrects (a chain solve) counts as about this many springs it only checks.
+constexpr std::uint64_t correction_cost = 8;
+
 ClothSubstep make_substep(int index, int count, double fixed_dt_s) noexcept {
     return ClothSubstep{index, count, fixed_dt_s, fixed_dt_s / count};
 }
@@ -179,14 +183,38 @@ void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep&) {
         s.part_counters[k].warp_moved =
             limit_warp_lines(*g.fabric, s.warp_rest_above, s.inv_mass, stretch, g.state.x, s.warp_moves, first_line, end_line);
     });
-    // Then the weft, row by row: a row crosses every band, so the rows are shared out instead.
+    // Then the weft, row by row: a row crosses every band, so the rows are shared out
+    // instead, in runs of neighbouring rows of about the same work. A row's work is its
+    // springs, checked in every pass, and the corrections it took in the last substep (most
+    // near a dress's hem, where the legs stretch it); where the runs end does not change the
+    // result, the rows being independent of each other.
     const std::size_t parts = s.parts.count;
     const std::uint32_t rows = g.fabric->particles_per_line;
+    std::vector<std::uint32_t>& work = s.weft_row_work;
+    work.resize(rows, 0);
+    std::array<std::uint32_t, max_parts + 1> edge{};
+    edge[parts] = rows;
+    if (parts > 1) {
+        const auto cost = [&](std::uint32_t row) { return std::uint64_t(g.fabric->warp_lines) + correction_cost * work[row]; };
+        std::uint64_t total = 0;
+        for (std::uint32_t row = 0; row < rows; ++row) total += cost(row);
+        std::uint64_t sum = 0;
+        std::size_t k = 1;
+        for (std::uint32_t row = 0; row < rows && k < parts; ++row) {
+            sum += cost(row);
+            while (k < parts && sum * parts >= total * k) edge[k++] = row + 1;
+        }
+        for (; k < parts; ++k) edge[k] = rows;
+    }
     for_each_part(parts, [&](std::size_t k) {
-        const auto first_row = static_cast<std::uint32_t>(rows * k / parts), end_row = static_cast<std::uint32_t>(rows * (k + 1) / parts);
-        s.part_counters[k].weft_moved =
-            limit_weft_rows(*g.fabric, s.weft_rest_right, s.inv_mass, stretch, g.state.x, s.weft_moves, first_row, end_row,
-                            &s.part_scratch[k].weft);
+        std::uint64_t corrected = 0;
+        for (std::uint32_t row = edge[k]; row < edge[k + 1]; ++row) {
+            const std::uint64_t c = limit_weft_rows(*g.fabric, s.weft_rest_right, s.inv_mass, stretch, g.state.x, s.weft_moves, row,
+                                                    row + 1, &s.part_scratch[k].weft);
+            work[row] = static_cast<std::uint32_t>(c);
+            corrected += c;
+        }
+        s.part_counters[k].weft_moved = corrected;
     });
 }
 
