@@ -65,8 +65,9 @@ struct PartCounters {
 struct PartScratch {
     WeftLimitScratch weft;
     std::vector<std::uint32_t> rows, lines;  ///< Repair: rows and lines its particles chose.
-    std::vector<std::uint32_t> moved;        ///< Repair: its particles that moved (collided again next).
-    std::vector<std::uint64_t> touched;      ///< Per particle of `moved`: its last_collided before that collision.
+    std::vector<std::uint32_t> moved;        ///< Repair: particles its limits moved (in any part's lines).
+    std::vector<std::uint32_t> collide;      ///< Repair: the moved particles of its lines, collided again.
+    std::vector<std::uint64_t> touched;      ///< Per particle of `collide`: its last_collided before that collision.
 };
 
 struct GarmentSolver {
@@ -114,7 +115,7 @@ struct GarmentSolver {
     Matrix3X repair_weft_moves;              ///< Per particle: the weft limit's move in the current repair round.
     VectorX repair_inv_mass;                 ///< The limits' inverse masses in the repair rounds (pushed particles heavier).
     std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
-    std::vector<std::uint32_t> repair_rows, repair_lines, repair_moved; ///< The repair rounds' choices, all parts'.
+    std::vector<std::uint32_t> repair_rows, repair_lines; ///< The repair rounds' choices, all parts'.
     std::vector<PartScratch> part_scratch;   ///< Per part.
     std::vector<std::uint32_t> weft_row_work; ///< Per weft row: springs the weft limit corrected in it last substep.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.

@@ -321,17 +321,17 @@ int over_limit(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::
     return springs;
 }
 
-// Part `part`'s particles in s.part_scratch[part].moved (moved after the lists were last
+// Part `part`'s particles in s.part_scratch[part].collide (moved after the lists were last
 // brought up to date) collided again, positions only, each against every active ellipsoid
 // (they are few and scattered: no list, no blocks); the particles pushed go to
-// s.pushed[part]. A particle and the one above it on its line are in the same part.
+// s.pushed[part].
 void collide_moved(Garment& g, GarmentSolver& s, std::size_t part) {
     PartScratch& ps = s.part_scratch[part];
     std::vector<std::uint32_t>& pushed = s.pushed[part];
     pushed.clear();
-    if (ps.moved.empty()) return;  // (collide_particles takes an empty list as every particle)
+    if (ps.collide.empty()) return;  // (collide_particles takes an empty list as every particle)
     Matrix3X& x = g.state.x;
-    const std::span<const std::uint32_t> moved = ps.moved;
+    const std::span<const std::uint32_t> moved = ps.collide;
     ps.touched.resize(moved.size());
     for (std::size_t k = 0; k < moved.size(); ++k) {
         s.x_round.col(moved[k]) = x.col(moved[k]);
@@ -353,13 +353,18 @@ void collide_moved(Garment& g, GarmentSolver& s, std::size_t part) {
     }
 }
 
+// `list` sorted, each entry once.
+void sort_unique(std::vector<std::uint32_t>& list) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+}
+
 // The parts' lists in `out`, sorted, each once.
 void merge_sorted(std::vector<std::uint32_t>& out, const std::vector<PartScratch>& parts,
                   std::vector<std::uint32_t> PartScratch::*list) {
     out.clear();
     for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
+    sort_unique(out);
 }
 
 // Contact repair (an extension of method §4.1-§5, docs/cloth.md "Contact repair"): the last
@@ -372,10 +377,11 @@ void merge_sorted(std::vector<std::uint32_t>& out, const std::vector<PartScratch
 // the body; then what they moved is collided again. Until no spring of a moved particle is
 // over the limit, or repair_rounds rounds (settling_repair_rounds in the first step).
 // Each stage of a round runs in parts at the same time, on particles no other part touches:
-// the choice by the particles' bands, the warp limit by the lines' bands, the weft limit on
-// a share of the rows, the collision by the particles' bands; what the parts chose or moved
-// is merged in index order between the stages, so the result is the same on any number of
-// threads.
+// the check of the moved particles, the warp limit on a share of the listed lines, the weft
+// limit on a share of the listed rows, the collision of what they moved by line (line number
+// modulo the parts: a particle and the one above it on its line, toward which the
+// collision's fallback may move it, in the same part, in index order). The result is the
+// same bytes on any number of threads.
 void repair_pushes(Garment& g, GarmentSolver& s) {
     const Fabric& f = *g.fabric;
     const std::uint32_t m = f.particles_per_line;
@@ -388,7 +394,7 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
     // spring over the limit after both has an end the weft limit moved (a row it did not
     // settle in its passes, or a warp spring its sideways move stretched).
     for_each_part(parts, [&](std::size_t k) {
-        std::vector<std::uint32_t>& moved = s.part_scratch[k].moved;
+        std::vector<std::uint32_t>& moved = s.part_scratch[k].collide;
         moved.clear();
         for (const auto [first, end] : s.parts.runs[k])
             for (Eigen::Index p = first; p < end; ++p)
@@ -410,7 +416,7 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
             };
             for (const std::uint32_t p : s.pushed[k])
                 if (choose(p)) s.repair_inv_mass[p] = s.inv_mass[p] * pushed_weight;
-            for (const std::uint32_t p : ps.moved) choose(p);
+            for (const std::uint32_t p : ps.collide) choose(p);
         });
         merge_sorted(s.repair_rows, s.part_scratch, &PartScratch::rows);
         merge_sorted(s.repair_lines, s.part_scratch, &PartScratch::lines);
@@ -422,12 +428,14 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
             if (moves.col(p).squaredNorm() > 0) moved.push_back(p);
             moves.col(p).setZero();
         };
+        const auto share = [&](const std::vector<std::uint32_t>& all, std::size_t k) {
+            const std::size_t n = all.size();
+            return std::span<const std::uint32_t>(all).subspan(n * k / parts, n * (k + 1) / parts - n * k / parts);
+        };
         for_each_part(parts, [&](std::size_t k) {
             PartScratch& ps = s.part_scratch[k];
             ps.moved.clear();
-            const auto [first_line, end_line] = s.parts.lines[k];
-            for (const std::uint32_t line : s.repair_lines) {
-                if (line < first_line || line >= end_line) continue;
+            for (const std::uint32_t line : share(s.repair_lines, k)) {
                 limit_warp_lines(f, s.warp_rest_above, w, stretch, x, s.repair_warp_moves, line, line + 1);
                 for (std::uint32_t row = 0; row < m; ++row) {
                     const std::uint32_t p = f.grid[line * m + row];
@@ -436,20 +444,22 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
                 }
             }
         });
-        const std::size_t row_count = s.repair_rows.size();
         for_each_part(parts, [&](std::size_t k) {
             PartScratch& ps = s.part_scratch[k];
-            const std::span<const std::uint32_t> rows =
-                std::span<const std::uint32_t>(s.repair_rows).subspan(row_count * k / parts, row_count * (k + 1) / parts - row_count * k / parts);
+            const std::span<const std::uint32_t> rows = share(s.repair_rows, k);
             limit_weft_rows(f, s.weft_rest_right, w, stretch, x, s.repair_weft_moves, rows, &ps.weft);
             for (const std::uint32_t row : rows)
                 for (std::uint32_t line = 0; line < f.warp_lines; ++line) take(s.repair_weft_moves, f.grid[line * m + row], ps.moved);
         });
-        // Once each, in index order, each in its own band's part.
-        merge_sorted(s.repair_moved, s.part_scratch, &PartScratch::moved);
-        for (PartScratch& ps : s.part_scratch) ps.moved.clear();
-        for (const std::uint32_t p : s.repair_moved) s.part_scratch[s.parts.band[p]].moved.push_back(p);
-        for_each_part(parts, [&](std::size_t k) { collide_moved(g, s, k); });
+        for_each_part(parts, [&](std::size_t k) {
+            PartScratch& ps = s.part_scratch[k];
+            ps.collide.clear();
+            for (const PartScratch& other : s.part_scratch)
+                for (const std::uint32_t p : other.moved)
+                    if (s.grid_place[p] / m % parts == k) ps.collide.push_back(p);
+            sort_unique(ps.collide);
+            collide_moved(g, s, k);
+        });
     }
 }
 
