@@ -65,8 +65,8 @@ struct GarmentParts {
 [[nodiscard]] GarmentParts make_parts(const Fabric& fabric, ClothModel model, Eigen::Index integrated);
 
 /// Calls f(k) for every part k in [0, count): in order on the calling thread for one part
-/// or when TBB may use one thread (tbb::global_control), else as TBB tasks (one part each) on the threads TBB has,
-/// returning when all are done.
+/// or when TBB may use one thread (tbb::global_control), else as TBB tasks (one part each)
+/// on the threads TBB has, returning when all are done.
 template <class F>
 void for_each_part(std::size_t count, F&& f) {
     if (count == 1 || tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) == 1) {
