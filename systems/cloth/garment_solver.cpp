@@ -114,6 +114,8 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
     if (s.weft_moves.cols() != n) s.weft_moves = Matrix3X::Zero(3, n);
     if (s.repair_warp_moves.cols() != n) s.repair_warp_moves = Matrix3X::Zero(3, n);
     if (s.repair_weft_moves.cols() != n) s.repair_weft_moves = Matrix3X::Zero(3, n);
+    if (s.repair_slack_m.size() != n) s.repair_slack_m = VectorX::Zero(n);
+    if (s.repair_lists.size() != static_cast<std::size_t>(n)) s.repair_lists.assign(static_cast<std::size_t>(n), 0);
     if (s.x_round.cols() != n) s.x_round = Matrix3X::Zero(3, n);
     if (s.x_start.cols() != n) s.x_start = Matrix3X::Zero(3, n);
     if (s.push.cols() != n) s.push = Matrix3X::Zero(3, n);

@@ -114,6 +114,8 @@ struct GarmentSolver {
     Matrix3X repair_warp_moves;              ///< Per particle: the warp limit's move in the current repair round.
     Matrix3X repair_weft_moves;              ///< Per particle: the weft limit's move in the current repair round.
     VectorX repair_inv_mass;                 ///< The limits' inverse masses in the repair rounds (pushed particles heavier).
+    std::vector<std::uint64_t> repair_lists; ///< Per particle collided in a repair round: its candidate list, or every collider.
+    VectorX repair_slack_m;                  ///< Per particle collided in a repair round: how far its list still holds from where it is.
     std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
     std::vector<std::uint32_t> repair_rows, repair_lines; ///< The repair rounds' choices, all parts'.
     std::vector<PartScratch> part_scratch;   ///< Per part.
