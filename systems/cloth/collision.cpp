@@ -843,6 +843,7 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
         }
     }
     part.valid = true;
+    part.frames_serial = solver.frames_serial;
     counters.list_tests += tests;
 }
 

@@ -37,6 +37,7 @@ struct CandidateListPart {
     bool valid = false;                      ///< False: rebuild before the next test.
     std::vector<Affine3> reference_frames;   ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed in this range (zero: none).
     std::vector<Eigen::Index> spent;         ///< Scratch: the particles whose list is refreshed.
+    std::uint64_t frames_serial = 0;         ///< GarmentSolver::frames_serial when its lists were last brought up to date.
 };
 
 /// Candidate lists with their references (method §5, spatial locality; collision.hpp step 1).
@@ -93,6 +94,7 @@ struct GarmentSolver {
     Real drag_step_s = 0;                    ///< Largest stable step of the explicit drag.
 
     std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep, one per GarmentBody::colliders.
+    std::uint64_t frames_serial = 0;         ///< Counts the poses `frames` was given by the step (a new substep, a reset).
     std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep (temporal coherence).
     CandidateLists lists;
 

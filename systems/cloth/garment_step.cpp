@@ -120,6 +120,7 @@ bool collides_after(int round, int rounds) noexcept { return (rounds - 1 - round
 void prepare_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
     update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
+    ++s.frames_serial;
 }
 
 void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int round) {
@@ -269,6 +270,30 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Ei
     }
 }
 
+// Whether part `part`'s candidate lists were brought up to date with the colliders where
+// they are now (in this substep's rounds).
+bool lists_up_to_date(const Garment& g, const GarmentSolver& s, std::size_t part) {
+    const CandidateLists& lists = s.lists;
+    return g.config.collision == CollisionMode::candidate_lists && lists.valid && part < lists.parts.size() &&
+           lists.parts[part].valid && lists.parts[part].frames_serial == s.frames_serial;
+}
+
+// Particle p, moved since its list was last brought up to date, to be collided again:
+// its list where the list still holds, else every collider, in s.repair_lists, and how
+// far it may still move from where it is now in s.repair_slack_m. A list holds while its
+// part's lists are up to date (lists_up_to_date) and the particle stays within its slack of
+// where it was at the update (collision.hpp step 1). `anchor`: the lists' frame (rigid, so
+// it keeps distances).
+void hold_list(const Garment& g, GarmentSolver& s, const Affine3& anchor, std::uint32_t p) {
+    Real left = -1;
+    if (lists_up_to_date(g, s, s.parts.band[p])) {
+        const Vec3 then(s.lists.scratch(0, p), s.lists.scratch(1, p), s.lists.scratch(2, p));
+        left = s.lists.slack_m[p] - (anchor.linear().transpose() * (g.state.x.col(p) - anchor.translation()) - then).norm();
+    }
+    s.repair_lists[p] = left >= 0 ? s.lists.bits[p] : ~std::uint64_t(0);
+    s.repair_slack_m[p] = std::max(left, Real(0));
+}
+
 // The warp and weft limits moved particles after the last collision round (on the sample
 // scene's walk the warp limit 153 of 837 per substep, 61 of them by a millimetre or more):
 // in band `part`, each block of 64 particles holding one is collided again, in the
@@ -323,12 +348,9 @@ int over_limit(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::
 
 // Part `part`'s particles in s.part_scratch[part].collide (moved after the lists were last
 // brought up to date) collided again, positions only, one at a time (they are few and
-// scattered: no blocks). Each is tested against its candidate list where the list still
-// holds: the lists were last brought up to date in this substep, with the colliders where
-// they are now, and a list holds while its particle stays within its slack of where it was
-// then (collision.hpp step 1); a particle moved farther is tested against every active
-// ellipsoid. The same contacts either way, for fewer tests. The particles pushed go to
-// s.pushed[part].
+// scattered: no blocks), each against its list where it still holds, else every active
+// ellipsoid (hold_list): the same contacts either way, for fewer tests. The particles
+// pushed go to s.pushed[part].
 void collide_moved(Garment& g, GarmentSolver& s, std::size_t part) {
     PartScratch& ps = s.part_scratch[part];
     std::vector<std::uint32_t>& pushed = s.pushed[part];
@@ -337,18 +359,13 @@ void collide_moved(Garment& g, GarmentSolver& s, std::size_t part) {
     Matrix3X& x = g.state.x;
     const std::span<const std::uint32_t> moved = ps.collide;
     ps.touched.resize(moved.size());
-    const bool lists = g.config.collision == CollisionMode::candidate_lists && s.lists.valid;
+    const bool lists = g.config.collision == CollisionMode::candidate_lists;
     const Affine3 anchor = anchor_frame(s.frames, g.body.anchor);
-    const Mat3 to_anchor = anchor.linear().transpose();  // rigid: the lists' frame keeps distances
     for (std::size_t k = 0; k < moved.size(); ++k) {
         const std::uint32_t p = moved[k];
         s.x_round.col(p) = x.col(p);
         ps.touched[k] = s.last_collided[p];
-        if (!lists) continue;
-        const Vec3 then(s.lists.scratch(0, p), s.lists.scratch(1, p), s.lists.scratch(2, p));
-        const Real left = s.lists.slack_m[p] - (to_anchor * (x.col(p) - anchor.translation()) - then).norm();
-        s.repair_lists[p] = left >= 0 ? s.lists.bits[p] : ~std::uint64_t(0);
-        s.repair_slack_m[p] = std::max(left, Real(0));
+        if (lists) hold_list(g, s, anchor, p);
     }
     const std::span<const Real> slack(s.repair_slack_m.data(), lists ? static_cast<std::size_t>(s.repair_slack_m.size()) : 0);
     const CollisionResult r = collide_particles(x, g.state.v, g.state.inv_mass, s.frames, lists ? &s.repair_lists : nullptr,
@@ -552,6 +569,7 @@ int step_garment(const Registry& registry, Garment& g, GarmentSolver& s, double 
 void reset_garment_state(const Registry& registry, Garment& g, GarmentSolver& s) {
     prepare_solver(g, s);
     update_frames(registry, g.body, s.frames, 1);
+    ++s.frames_serial;
     const Affine3 anchor = anchor_frame(s.frames, g.body.anchor);
     GarmentState& state = g.state;
     const Eigen::Index n = state.x.cols();
