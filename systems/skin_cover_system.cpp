@@ -67,7 +67,8 @@ void choose_cover(Registry& registry, const Garment& g, std::span<const Ellipsoi
     }
 }
 
-// Pulls the covered vertices of `skin` that stand out of `frames` (skin_cover_system.hpp).
+// Pulls the covered vertices of `skin` that stand out of `frames`, or lie less deep in them
+// than a pulled vertex is drawn (skin_cover_system.hpp).
 std::uint64_t pull_in(std::span<const EllipsoidFrame> frames, const SkinCover& cover, SkinnedMesh& skin) {
     std::uint64_t pulled = 0;
     for (const std::uint32_t v : cover.vertices) {
@@ -81,11 +82,11 @@ std::uint64_t pull_in(std::span<const EllipsoidFrame> frames, const SkinCover& c
             if (!f.active) continue;
             const Vec3 d = x - f.center;
             const Real y = (f.to_unit * d).norm();
-            if (y <= 1) {
+            if (y <= 1 - skin_cover_inset) {  // already as deep as a pulled vertex is drawn
                 inside = true;
                 break;
             }
-            const Real outside = d.norm() * (1 - 1 / y);  // along the centre line to the surface
+            const Real outside = d.norm() * (1 - 1 / y);  // along the centre line to the surface (< 0 inside)
             if (outside < nearest) {
                 nearest = outside;
                 to = &f;

@@ -7,8 +7,11 @@
 // through the garment. Game engines hide body skin under clothing for the same reason.
 // This system moves, for drawing only, every covered skinned vertex that lies outside all
 // of the garment's ellipsoids but within `skin_cover_reach_m` of one onto the surface of the
-// nearest (along its centre line) and `skin_cover_inset` inside it. Skin farther out is left
-// alone: it is not the body under the cloth (a hand, a bag).
+// nearest (along its centre line) and `skin_cover_inset` inside it. So too a vertex inside
+// but less deep than that in every ellipsoid: the cloth is drawn as flat triangles between
+// particles that lie on the ellipsoids, which cut a little inside a curved surface, and
+// skin just under the surface (where the legs' tight ellipsoids hug it) showed through
+// them. Skin farther out is left alone: it is not the body under the cloth (a hand, a bag).
 //
 // Covered: the vertices whose strongest bone is neither an arm, a hand nor the head (nor a
 // bone below them), and that lay between the garment's hem and its highest pin when the

@@ -11,7 +11,8 @@ Result<CharacterBody> fit_character_body(const CharacterAsset& character, const 
     if (!character.skeleton || !character.mesh) return fail(at + "no skeleton or mesh to fit a body to");
     CharacterBody body;
     body.hip_bone = find_hip_bone(*character.skeleton);
-    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips, character.meshes);
+    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips, character.meshes,
+                                     &body.legs);
     if (auto landmarks = find_body_landmarks(character)) body.landmarks = std::move(*landmarks);
     else body.landmarks_error = landmarks.error().message;
     return body;

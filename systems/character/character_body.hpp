@@ -21,6 +21,7 @@ namespace drape {
 struct CharacterBody {
     std::vector<EllipsoidShape> ellipsoids;  ///< Fitted, bone space: bone, center, rotation, radii_m.
     int hip_bone = -1;                       ///< find_hip_bone(); -1 when none.
+    LegFit legs = LegFit::bounding;          ///< The leg fit fit_ellipsoids used (tight or bounding).
     std::optional<BodyLandmarks> landmarks;  ///< find_body_landmarks(); none for a body that is not a humanoid.
     std::string landmarks_error;             ///< Why there are none.
 };

@@ -63,7 +63,7 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
         if (clip.travel_m.norm() > 1e-3f) out += format("  travels %.2f m", double(clip.travel_m.norm()));
         out += "\n";
     }
-    out += format("  ellipsoids  %zu fitted\n", body.ellipsoids.size());
+    out += format("  ellipsoids  %zu fitted, legs %s\n", body.ellipsoids.size(), leg_fit_name(body.legs));
     for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {
         const EllipsoidShape& e = body.ellipsoids[i];
         out += format("    %-20s %-10s radii %.3f %.3f %.3f m  bulge %.3f m\n", s.bone_names[std::size_t(e.bone)].c_str(),
@@ -114,6 +114,7 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
     for (const auto& clip : c.clips)
         j["clips"].push_back({{"name", clip->name}, {"duration_s", clip->duration_s}, {"channels", clip->channels.size()},
                               {"travel_m", {clip->travel_m.x(), clip->travel_m.y(), clip->travel_m.z()}}});
+    j["legs"] = leg_fit_name(body.legs);
     j["ellipsoids"] = json::array();
     for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {
         const EllipsoidShape& e = body.ellipsoids[i];

@@ -76,7 +76,7 @@ Matrix3X sphere_samples(int n) {
 
 // The ellipsoid that bounds a cluster, in the bone frame `frame` (rigid, model space at
 // bind): principal axes, centred on the box they span, scaled uniformly until 97 % of the
-// points are inside. The legs keep it (FitOptions::hug_legs).
+// points are inside. Bounded legs keep it (LegFit::bounding).
 EllipsoidShape bounding_ellipsoid(const MeshAsset& mesh, const Affine3& frame, const std::vector<Eigen::Index>& c, double min_radius_m) {
     constexpr double cluster_coverage = 0.97;
     const Affine3 to_bone = frame.inverse();
@@ -264,6 +264,10 @@ Result<void> validate(const FitOptions& o) {
     if (!(o.min_radius_m > 0 && std::isfinite(o.min_radius_m))) return fail("fit.min_radius_m: must be > 0");
     if (o.max_ellipsoids < 0) return fail("fit.max_ellipsoids: must be >= 0 (0: no limit)");
     if (!(o.leg_reach_m <= 1)) return fail("fit.leg_reach_m: must be <= 1 m (< 0: no limit)");
+    if (!(o.target_coverage > 0 && o.target_coverage <= 1)) return fail("fit.target_coverage: must be in (0, 1]");
+    if (!(o.knee_radius_share >= 0 && o.knee_radius_share <= 4)) return fail("fit.knee_radius_share: must be in [0, 4] (0: no knee spheres)");
+    if (o.legs != LegFit::automatic && o.legs != LegFit::tight && o.legs != LegFit::bounding)
+        return fail("fit.legs: must be automatic, tight or bounding");
     return {};
 }
 
@@ -313,10 +317,12 @@ std::vector<int> dominant_bones(const MeshAsset& mesh) {
     return out;
 }
 
-std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
-                                           const FitOptions& options,
-                                           std::span<const std::shared_ptr<const AnimationClip>> clips,
-                                           std::span<const MeshInfo> meshes) {
+namespace {
+
+// fit_ellipsoids with the legs fitted tight (`tight_legs`) or bounded.
+std::vector<EllipsoidShape> fit_with(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
+                                     const FitOptions& options, std::span<const std::shared_ptr<const AnimationClip>> clips,
+                                     std::span<const MeshInfo> meshes, bool tight_legs) {
     const std::size_t bones = skeleton.size();
     const std::size_t n = mesh.vertex_count();
     std::vector<std::vector<Eigen::Index>> clusters(bones);
@@ -452,7 +458,7 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
         part_info[p].may_split = !limb(region);
         // Only hugged legs keep their fitted ellipsoid; the reach term on legs that are
         // replaced by their bounding ellipsoids below would still move their neighbours.
-        part_info[p].limited_reach = options.hug_legs && options.leg_reach_m >= 0 &&
+        part_info[p].limited_reach = tight_legs && options.leg_reach_m >= 0 &&
                                      (region == BodyRegion::upper_leg || region == BodyRegion::lower_leg);
     }
 
@@ -472,6 +478,12 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
     settings.min_radius_m = options.min_radius_m;
     settings.reach_m = std::max(0.0, options.leg_reach_m);
     settings.max_pieces = options.max_ellipsoids > 0 ? options.max_ellipsoids : 1 << 20;
+    // Tight legs: a sphere at each knee (below), on top of the budget.
+    std::vector<int> knees;
+    if (tight_legs && options.knee_radius_share > 0)
+        for (const int b : bone_of_part)
+            if (region_of(static_cast<std::size_t>(b)) == BodyRegion::lower_leg && std::find(knees.begin(), knees.end(), b) == knees.end())
+                knees.push_back(b);
     const SkinSurface skin(positions, normals, mesh.indices);
     std::vector<fitting::Piece> pieces = fitting::fit_pieces(skin, samples, part_of, part_info, settings);
     // Grouped by bone, in the order of the skeleton; a bone's pieces in the order they came.
@@ -488,9 +500,8 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
         shape.rotation = Quat(Eigen::Quaterniond(to_bone.linear() * piece.shape.axes).normalized().cast<Real>());
         shape.radii_m = piece.shape.radii.cast<Real>().cwiseMax(static_cast<Real>(options.min_radius_m));
         shape.region = holds_hip[b] ? BodyRegion::pelvis : region_from_bone_name(skeleton.bone_names[b]);
-        // A leg keeps the ellipsoid that bounds its bone's vertices unless asked to hug:
-        // see FitOptions::hug_legs.
-        if (!options.hug_legs && (shape.region == BodyRegion::upper_leg || shape.region == BodyRegion::lower_leg) &&
+        // A bounded leg keeps the ellipsoid that bounds its bone's vertices: see LegFit.
+        if (!tight_legs && (shape.region == BodyRegion::upper_leg || shape.region == BodyRegion::lower_leg) &&
             static_cast<std::size_t>(piece.part) < bone_parts) {
             std::vector<Eigen::Index> own;
             for (std::size_t j = 0; j < n; ++j)
@@ -501,6 +512,24 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
             shape.region = region;
         }
         shapes.push_back(shape);
+    }
+    // The knee spheres: capsule chains put a sphere at every joint; the thigh's and the
+    // shin's tight ellipsoids leave a crease behind the knee that closes on a hem as the knee
+    // bends. Centred on the shin bone's joint, knee_radius_share x the distance from the
+    // joint to the nearest skin of the thigh and the shin.
+    for (const int b : knees) {
+        const int thigh = skeleton.parents[static_cast<std::size_t>(b)];
+        const Vec3 joint = global[static_cast<std::size_t>(b)].translation();
+        Real nearest = std::numeric_limits<Real>::max();
+        for (std::size_t j = 0; j < n; ++j)
+            if (dominant[j] == b || dominant[j] == thigh)
+                nearest = std::min(nearest, (positions.col(static_cast<Eigen::Index>(j)) - joint).norm());
+        if (nearest == std::numeric_limits<Real>::max()) continue;
+        EllipsoidShape knee;
+        knee.bone = b;  // bone space: the joint is the origin
+        knee.radii_m = Vec3::Constant(std::max(static_cast<Real>(options.knee_radius_share) * nearest, static_cast<Real>(options.min_radius_m)));
+        knee.region = BodyRegion::lower_leg;
+        shapes.push_back(knee);
     }
     // No cluster holds the hip bone's vertices (a rig whose pelvis mesh hangs from a
     // sibling bone): the trunk ellipsoids nearest the hip joint stand for the pelvis.
@@ -518,6 +547,44 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
             if (s.bone == nearest) s.region = BodyRegion::pelvis;
     }
     return shapes;
+}
+
+}  // namespace
+
+const char* leg_fit_name(LegFit legs) noexcept {
+    switch (legs) {
+        case LegFit::automatic: return "automatic";
+        case LegFit::tight: return "tight";
+        case LegFit::bounding: return "bounding";
+    }
+    return "unknown";
+}
+
+bool meets_fit_targets(const CoverageReport& report, const FitOptions& options) noexcept {
+    return report.coverage >= options.target_coverage && report.p95_bulge_m <= options.bulge_limit_m;
+}
+
+std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
+                                           const FitOptions& options,
+                                           std::span<const std::shared_ptr<const AnimationClip>> clips,
+                                           std::span<const MeshInfo> meshes, LegFit* legs) {
+    if (options.legs != LegFit::automatic) {
+        if (legs) *legs = options.legs;
+        return fit_with(skeleton, mesh, height_m, options, clips, meshes, options.legs == LegFit::tight);
+    }
+    // Automatic: the tight legs where the whole fit then meets its targets at the rest pose.
+    std::vector<EllipsoidShape> tight = fit_with(skeleton, mesh, height_m, options, clips, meshes, true);
+    std::vector<Affine3> global, skinning;
+    compose_pose(skeleton, skeleton.rest_local, global);
+    skinning_matrices(skeleton, global, skinning);
+    Matrix3X positions, normals;
+    skin_mesh(mesh, skinning, Affine3::Identity(), positions, normals);
+    if (meets_fit_targets(measure_coverage(tight, global, positions, normals, mesh.indices, options.tolerance_m), options)) {
+        if (legs) *legs = LegFit::tight;
+        return tight;
+    }
+    if (legs) *legs = LegFit::bounding;
+    return fit_with(skeleton, mesh, height_m, options, clips, meshes, false);
 }
 
 Affine3 ellipsoid_transform(const EllipsoidShape& shape, const Affine3& bone_global) {

@@ -17,16 +17,22 @@
 // the knee and the hip where the cloth's hem catches. Shapes are stored in the rigid
 // frame of their bone at the rest pose.
 //
-// The legs: by default (`hug_legs` false) each leg bone keeps the ellipsoid that bounds its
-// vertices (principal axes, 97 % of them inside), which stands out of the skin by several
-// centimetres, most between the thighs, and misses the 2 cm bulge target there. With
-// `hug_legs`, each leg bone gets one ellipsoid fitted tight, which may not reach more than
-// `leg_reach_m` past its own skin along the leg (ellipsoid_solver.hpp, "reach"): a shin's
-// tip hidden inside the thigh at the rest pose would stand out behind the bent knee. The
-// fit then meets the target, and the sample skirt holds its strain (worst spring 9 %), but
-// the shared characters' garments tear more with it (docs/cloth.md, "Known limits"). Up to
-// a centimetre of thigh skin lies outside the tight ellipsoids; the skin cover system draws
-// it inside them (systems/skin_cover_system.hpp).
+// The legs (LegFit): fitted tight, each leg bone gets one ellipsoid fitted like the rest,
+// which may not reach more than `leg_reach_m` past its own skin along the leg
+// (ellipsoid_solver.hpp, "reach": a shin's tip hidden inside the thigh at the rest pose
+// would stand out behind the bent knee), and each knee a sphere on the shin's joint
+// (`knee_radius_share` x the joint's distance to the nearest leg skin), as capsule chains
+// put a sphere at every joint: without it the crease the two ellipsoids leave behind the
+// knee closes on a hem as the knee bends (a dress on the long-legged build: worst spring
+// 256 %, 10.0 % with the spheres). Bounded, each leg bone keeps the ellipsoid that bounds
+// its vertices (principal axes, 97 % of them inside), which stands out of the skin by
+// several centimetres, most between the thighs. By default (automatic) the legs are fitted
+// tight where the whole fit then meets its targets at the rest pose (meets_fit_targets:
+// coverage and p95 bulge), else bounded: the humans fitted so far meet them (p95 bulge
+// 1.6-2.0 cm, against 5-7 cm bounded); RobotExpressive does not either way (4.5 cm, its
+// plates), and its dress holds its springs on the bounded legs (docs/cloth.md, "Known
+// limits"). Up to a centimetre of thigh skin lies outside the tight ellipsoids; the skin
+// cover system draws it inside them (systems/skin_cover_system.hpp).
 //
 // Measures (measure_coverage):
 //  - coverage: the share of skin vertices inside some ellipsoid or within `tolerance_m` of
@@ -59,17 +65,26 @@
 
 namespace drape {
 
+/// How the legs are fitted (see the header comment).
+enum class LegFit : std::uint8_t {
+    automatic,  ///< Tight where the whole fit then meets its targets (meets_fit_targets), else bounding.
+    tight,      ///< One ellipsoid per leg bone fitted to the skin, its reach along the leg limited.
+    bounding,   ///< One ellipsoid per leg bone bounding its vertices.
+};
+
 /// How ellipsoids are fitted (the numeric details are ellipsoid_solver.hpp's).
 struct FitOptions {
     double min_cluster_fraction = 0.004;   ///< A bone with fewer of the vertices than this merges into its parent.
     double min_cluster_size = 0.09;        ///< ... or whose cluster is shorter than this share of the height.
     double tolerance_m = 0.01;             ///< A skin point this close to an ellipsoid is covered.
-    double bulge_limit_m = 0.02;           ///< Surface standing out of the skin farther than this fails (asks for a split).
+    double bulge_limit_m = 0.02;           ///< Surface standing out of the skin farther than this fails (asks for a split); the p95 bulge target.
+    double target_coverage = 0.99;         ///< Share of skin vertices within tolerance_m of the ellipsoids the fit aims for.
     double sample_spacing = 0.016;         ///< Skin samples inside large faces at most this share of the height apart.
     double min_radius_m = 0.01;            ///< No axis thinner than this.
-    int max_ellipsoids = 32;               ///< Budget (the paper's avatar has 15, a garment takes 64); 0 = no limit.
+    int max_ellipsoids = 32;               ///< Budget of fitted pieces (the paper's avatar has 15, a garment takes 64), knee spheres on top; 0 = no limit.
     double leg_reach_m = 0.05;             ///< A hugged leg's ellipsoid may pass its own skin along the leg by this much (< 0: no limit).
-    bool hug_legs = false;                 ///< Fit the legs tight too (see the header comment); else they keep their bounding ellipsoids.
+    LegFit legs = LegFit::automatic;       ///< How the legs are fitted (see the header comment).
+    double knee_radius_share = 1.2;        ///< Tight legs: a sphere at each knee, this x the joint's distance to the nearest leg skin (0: none).
 };
 
 /// Checks the options; the error names the field.
@@ -88,11 +103,13 @@ struct FitOptions {
 /// Fits ellipsoids to the skin at the skeleton's rest pose. `height_m` sets the scale of
 /// "small" clusters and of the sample spacing; `clips` tell which joints move (stiff ones
 /// merge first when over budget); `meshes` (CharacterAsset::meshes) tell which vertices
-/// belong to rigid objects. Deterministic: the same input gives the same shapes.
+/// belong to rigid objects. `legs`, when given, receives the leg fit used (tight or
+/// bounding; with LegFit::automatic the tight fit is made first, and the bounding one too
+/// when the tight misses its targets). Deterministic: the same input gives the same shapes.
 [[nodiscard]] std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh,
                                                          Real height_m, const FitOptions& options = {},
                                                          std::span<const std::shared_ptr<const AnimationClip>> clips = {},
-                                                         std::span<const MeshInfo> meshes = {});
+                                                         std::span<const MeshInfo> meshes = {}, LegFit* legs = nullptr);
 
 /// An ellipsoid's unit sphere -> the space of `bone_global` (rigid part of the bone used).
 [[nodiscard]] Affine3 ellipsoid_transform(const EllipsoidShape& shape, const Affine3& bone_global);
@@ -122,6 +139,13 @@ struct CoverageReport {
 [[nodiscard]] CoverageReport measure_coverage(std::span<const EllipsoidShape> shapes, std::span<const Affine3> global,
                                               const Matrix3X& positions, const Matrix3X& normals,
                                               std::span<const std::uint32_t> triangles, double tolerance_m = 0.01);
+
+/// Whether a fit's coverage report meets the targets of `options`: coverage at least
+/// target_coverage (within the report's tolerance) and a p95 bulge at most bulge_limit_m.
+[[nodiscard]] bool meets_fit_targets(const CoverageReport& report, const FitOptions& options) noexcept;
+
+/// "automatic", "tight", "bounding".
+[[nodiscard]] const char* leg_fit_name(LegFit legs) noexcept;
 
 /// Reads manual ellipsoids from JSON text: an array of
 /// `{"bone": "Hips", "center": [x,y,z], "radii_m": [a,b,c], "rotation": [x,y,z,w], "region": "pelvis"}`

@@ -29,6 +29,8 @@ TEST(CharacterReport, TextAndJsonNameMeshesBonesClipsEllipsoidsCoverageAndHeight
     EXPECT_EQ(json["clips"][0]["name"], "Bend");
     EXPECT_NEAR(json["clips"][0]["duration_s"].get<double>(), 1.0, 1e-6);
     EXPECT_EQ(json["ellipsoids"].size(), body->ellipsoids.size());
+    EXPECT_EQ(json["legs"], leg_fit_name(body->legs));  // the leg fit used: tight or bounding
+    EXPECT_NE(json["legs"], "automatic");
     EXPECT_GE(json["coverage"]["share"].get<double>(), 0.95);
 }
 

@@ -24,6 +24,7 @@
 #include "systems/character/character_body.hpp"
 #include "systems/character/character_report.hpp"
 #include "systems/character/pose.hpp"
+#include "tests/character/leg_expectations.hpp"
 #include "tests/game/character_contract.hpp"
 
 namespace drape {
@@ -289,36 +290,35 @@ TEST(DefaultAvatar, ImportsLikeAnyCharacter) {
 }
 
 // The fitted ellipsoids: within a garment's 64 colliders and the fit's budget, one
-// ellipsoid per leg bone, a pelvis. Fitted with the legs tight too (FitOptions::hug_legs),
-// they hug the body to the target: 99 % of the skin within 1 cm of them and 95 % of their
-// surface that stands out of the skin no more than 2 cm out. The default fit keeps the legs'
-// bounding ellipsoids (tight legs leave skin showing through the cloth: docs/cloth.md,
-// "Known limits"): there the target is missed and the bound below guards the rest of the
-// fit (a trunk or arm piece floating off the body would break it).
-constexpr double default_fit_p95_bulge_bound_m = 0.08;
+// ellipsoid per leg bone, a pelvis. With the legs fitted tight (LegFit::tight) they hug
+// the body to the target: 99 % of the skin within 1 cm of them and 95 % of their surface
+// that stands out of the skin no more than 2 cm out. With the legs' bounding ellipsoids
+// (LegFit::bounding) the target is missed between the thighs, and the bound below guards
+// the rest of the fit (a trunk or arm piece floating off the body would break it). The
+// default (LegFit::automatic) makes the tight fit here: it meets the targets.
+constexpr double bounding_fit_p95_bulge_bound_m = 0.08;
 
-void expect_fitted_ellipsoids(const CharacterAsset& c, const std::string& what, bool hug_legs) {
-    SCOPED_TRACE(what + (hug_legs ? ", legs hugged" : ", default fit"));
+void expect_fitted_ellipsoids(const CharacterAsset& c, const std::string& what, LegFit legs) {
+    SCOPED_TRACE(what + ", legs " + leg_fit_name(legs));
     FitOptions options;
-    options.hug_legs = hug_legs;
+    options.legs = legs;
     const auto body = fit_character_body(c, options);
     ASSERT_TRUE(body) << body.error().message;
     EXPECT_GE(body->ellipsoids.size(), 12u);
-    EXPECT_LE(body->ellipsoids.size(), std::size_t(options.max_ellipsoids));
     EXPECT_LE(body->ellipsoids.size(), 64u);
+    test::expect_legs(*body, options);
     auto count = [&](BodyRegion r) { return std::count_if(body->ellipsoids.begin(), body->ellipsoids.end(), [&](auto& e) { return e.region == r; }); };
-    EXPECT_EQ(count(BodyRegion::upper_leg), 2);
-    EXPECT_EQ(count(BodyRegion::lower_leg), 2);
     EXPECT_GE(count(BodyRegion::pelvis), 1);
     EXPECT_TRUE(body->landmarks) << body->landmarks_error;
     const CoverageReport coverage = rest_pose_coverage(c, *body);
     EXPECT_GE(coverage.coverage, 0.99) << "largest gap " << coverage.max_gap_m << " m";
-    EXPECT_LE(coverage.p95_bulge_m, hug_legs ? 0.02 : default_fit_p95_bulge_bound_m) << "max bulge " << coverage.max_bulge_m << " m";
+    EXPECT_LE(coverage.p95_bulge_m, legs == LegFit::bounding ? bounding_fit_p95_bulge_bound_m : 0.02)
+        << "max bulge " << coverage.max_bulge_m << " m";
+    EXPECT_EQ(body->legs, legs == LegFit::automatic ? LegFit::tight : legs);
 }
 
 void expect_hugging_ellipsoids(const CharacterAsset& c, const std::string& what) {
-    expect_fitted_ellipsoids(c, what, true);
-    expect_fitted_ellipsoids(c, what, false);
+    for (const LegFit legs : {LegFit::automatic, LegFit::tight, LegFit::bounding}) expect_fitted_ellipsoids(c, what, legs);
 }
 
 TEST(DefaultAvatar, FittedEllipsoidsHugTheBody) {
@@ -362,21 +362,21 @@ TEST(DefaultAvatar, FittedLegsKeepHuggingThroughTheWalk) {
     const auto imported = import_character(committed_avatar);
     ASSERT_TRUE(imported) << imported.error().message;
     FitOptions options;
-    options.hug_legs = true;
+    options.legs = LegFit::tight;
     const auto [p95, max] = walk_bulge(**imported, options);
     EXPECT_LE(p95, 0.025);
     EXPECT_LE(max, 0.12);
 }
 
-// The leg reach shapes hugged legs only: with the legs' bounding ellipsoids (the default)
-// the fit is the same whatever the reach, since a reach term on the legs fitted jointly
-// with the trunk would still move the trunk's pieces.
-TEST(DefaultAvatar, LegReachLeavesTheDefaultFitAlone) {
+// The leg reach shapes hugged legs only: with the legs' bounding ellipsoids the fit is the
+// same whatever the reach, since a reach term on the legs fitted jointly with the trunk
+// would still move the trunk's pieces.
+TEST(DefaultAvatar, LegReachLeavesTheBoundingFitAlone) {
     const auto imported = import_character(committed_avatar);
     ASSERT_TRUE(imported) << imported.error().message;
     FitOptions reach, none;
     none.leg_reach_m = -1;
-    ASSERT_FALSE(reach.hug_legs);
+    reach.legs = none.legs = LegFit::bounding;
     const auto a = fit_character_body(**imported, reach), b = fit_character_body(**imported, none);
     ASSERT_TRUE(a && b);
     ASSERT_EQ(a->ellipsoids.size(), b->ellipsoids.size());
@@ -386,7 +386,7 @@ TEST(DefaultAvatar, LegReachLeavesTheDefaultFitAlone) {
         EXPECT_TRUE(a->ellipsoids[i].radii_m.isApprox(b->ellipsoids[i].radii_m, 1e-6f)) << i;
     }
     // And hugged legs do feel it.
-    reach.hug_legs = none.hug_legs = true;
+    reach.legs = none.legs = LegFit::tight;
     const auto c = fit_character_body(**imported, reach), d = fit_character_body(**imported, none);
     ASSERT_TRUE(c && d);
     bool differ = c->ellipsoids.size() != d->ellipsoids.size();
