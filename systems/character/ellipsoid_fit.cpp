@@ -560,8 +560,12 @@ const char* leg_fit_name(LegFit legs) noexcept {
     return "unknown";
 }
 
+bool covers_skin(const CoverageReport& report, const FitOptions& options) noexcept {
+    return report.coverage >= options.target_coverage;
+}
+
 bool meets_fit_targets(const CoverageReport& report, const FitOptions& options) noexcept {
-    return report.coverage >= options.target_coverage && report.p95_bulge_m <= options.bulge_limit_m;
+    return covers_skin(report, options) && report.p95_bulge_m <= options.bulge_limit_m;
 }
 
 std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
@@ -572,14 +576,15 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
         if (legs) *legs = options.legs;
         return fit_with(skeleton, mesh, height_m, options, clips, meshes, options.legs == LegFit::tight);
     }
-    // Automatic: the tight legs where the whole fit then meets its targets at the rest pose.
+    // Automatic: the tight legs where the whole fit then covers the skin to the target at the
+    // rest pose (covers_skin).
     std::vector<EllipsoidShape> tight = fit_with(skeleton, mesh, height_m, options, clips, meshes, true);
     std::vector<Affine3> global, skinning;
     compose_pose(skeleton, skeleton.rest_local, global);
     skinning_matrices(skeleton, global, skinning);
     Matrix3X positions, normals;
     skin_mesh(mesh, skinning, Affine3::Identity(), positions, normals);
-    if (meets_fit_targets(measure_coverage(tight, global, positions, normals, mesh.indices, options.tolerance_m), options)) {
+    if (covers_skin(measure_coverage(tight, global, positions, normals, mesh.indices, options.tolerance_m), options)) {
         if (legs) *legs = LegFit::tight;
         return tight;
     }

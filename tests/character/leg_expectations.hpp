@@ -25,11 +25,12 @@ inline void expect_legs(const CharacterBody& body, const FitOptions& options) {
     EXPECT_EQ(knees, body.legs == LegFit::tight && options.knee_radius_share > 0 ? 2 : 0);
     EXPECT_EQ(count([](const EllipsoidShape& e) { return e.region == BodyRegion::upper_leg; }), 2);
     EXPECT_EQ(count([](const EllipsoidShape& e) { return e.region == BodyRegion::lower_leg && !is_knee_sphere(e); }), 2);
-    for (const EllipsoidShape& knee : body.ellipsoids)
-        if (is_knee_sphere(knee))
-            EXPECT_TRUE(std::any_of(body.ellipsoids.begin(), body.ellipsoids.end(), [&](const EllipsoidShape& shin) {
-                return shin.bone == knee.bone && !is_knee_sphere(shin);
-            })) << "a knee sphere sits on a shin bone";
+    for (const EllipsoidShape& knee : body.ellipsoids) {
+        if (!is_knee_sphere(knee)) continue;
+        EXPECT_TRUE(std::any_of(body.ellipsoids.begin(), body.ellipsoids.end(), [&](const EllipsoidShape& shin) {
+            return shin.bone == knee.bone && !is_knee_sphere(shin);
+        })) << "a knee sphere sits on a shin bone";
+    }
     EXPECT_LE(body.ellipsoids.size() - static_cast<std::size_t>(knees), static_cast<std::size_t>(options.max_ellipsoids));
 }
 

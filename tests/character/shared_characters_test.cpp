@@ -96,8 +96,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Expect{"characters/rigged_simple/RiggedSimple.glb", 1, "0", 2.08, 2, false}),
     [](const auto& info) { return std::filesystem::path(info.param.file).stem().string(); });
 
-// By default the legs are fitted tight where the fit then meets its targets
-// (LegFit::automatic): on the human characters it does, and the whole body is hugged.
+// By default the legs are fitted tight where the fit then covers the skin
+// (LegFit::automatic): on the human characters it does, and the whole body is hugged to
+// the targets.
 TEST(SharedCharacterFit, TheHumansGetTightLegsAndTheFitHugsTheWholeBody) {
     for (const char* file : {"characters/male_casual/Male_Casual.fbx", "characters/female_alternative/Female_Alternative.fbx"}) {
         SCOPED_TRACE(file);
@@ -117,9 +118,9 @@ TEST(SharedCharacterFit, TheHumansGetTightLegsAndTheFitHugsTheWholeBody) {
     }
 }
 
-// Where the tight legs leave the fit short of its targets (RobotExpressive: plates and
-// ball joints, 97 % coverage either way), the default keeps the legs' bounding ellipsoids,
-// the same shapes as asking for them.
+// Where the tight legs leave the skin short of the coverage target (RobotExpressive: plates
+// and ball joints, 97 % either way), the default keeps the legs' bounding ellipsoids, the
+// same shapes as asking for them.
 TEST(SharedCharacterFit, WhereTightLegsMissTheTargetsTheLegsAreBounded) {
     const auto path = shared("characters/robot_expressive/RobotExpressive.glb");
     REQUIRE_SHARED(path);
@@ -129,7 +130,7 @@ TEST(SharedCharacterFit, WhereTightLegsMissTheTargetsTheLegsAreBounded) {
     tight.legs = LegFit::tight;
     const auto tight_body = fit_character_body(**r, tight);
     ASSERT_TRUE(tight_body) << tight_body.error().message;
-    EXPECT_FALSE(meets_fit_targets(rest_pose_coverage(**r, *tight_body), tight));
+    EXPECT_FALSE(covers_skin(rest_pose_coverage(**r, *tight_body), tight));
     FitOptions bounding;
     bounding.legs = LegFit::bounding;
     const auto automatic = fit_character_body(**r), bounded = fit_character_body(**r, bounding);
