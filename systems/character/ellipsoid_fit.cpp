@@ -266,6 +266,7 @@ Result<void> validate(const FitOptions& o) {
     if (!(o.leg_reach_m <= 1)) return fail("fit.leg_reach_m: must be <= 1 m (< 0: no limit)");
     if (!(o.target_coverage > 0 && o.target_coverage <= 1)) return fail("fit.target_coverage: must be in (0, 1]");
     if (!(o.knee_radius_share >= 0 && o.knee_radius_share <= 4)) return fail("fit.knee_radius_share: must be in [0, 4] (0: no knee spheres)");
+    if (o.tight_extra_ellipsoids < 0) return fail("fit.tight_extra_ellipsoids: must be >= 0");
     if (o.legs != LegFit::automatic && o.legs != LegFit::tight && o.legs != LegFit::bounding)
         return fail("fit.legs: must be automatic, tight or bounding");
     return {};
@@ -477,7 +478,7 @@ std::vector<EllipsoidShape> fit_with(const SkeletonAsset& skeleton, const MeshAs
     settings.bulge_limit_m = options.bulge_limit_m;
     settings.min_radius_m = options.min_radius_m;
     settings.reach_m = std::max(0.0, options.leg_reach_m);
-    settings.max_pieces = options.max_ellipsoids > 0 ? options.max_ellipsoids : 1 << 20;
+    settings.max_pieces = options.max_ellipsoids > 0 ? options.max_ellipsoids + (tight_legs ? options.tight_extra_ellipsoids : 0) : 1 << 20;
     // Tight legs: a sphere at each knee (below), on top of the budget.
     std::vector<int> knees;
     if (tight_legs && options.knee_radius_share > 0)

@@ -83,6 +83,7 @@ struct FitOptions {
     double sample_spacing = 0.016;         ///< Skin samples inside large faces at most this share of the height apart.
     double min_radius_m = 0.01;            ///< No axis thinner than this.
     int max_ellipsoids = 32;               ///< Budget of fitted pieces (the paper's avatar has 15, a garment takes 64), knee spheres on top; 0 = no limit.
+    int tight_extra_ellipsoids = 2;        ///< With tight legs the budget grows by this many pieces (the trunk's decide the bulge).
     double leg_reach_m = 0.05;             ///< A hugged leg's ellipsoid may pass its own skin along the leg by this much (< 0: no limit).
     LegFit legs = LegFit::automatic;       ///< How the legs are fitted (see the header comment).
     double knee_radius_share = 1.2;        ///< Tight legs: a sphere at each knee, this x the joint's distance to the nearest leg skin (0: none).

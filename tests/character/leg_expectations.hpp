@@ -1,7 +1,8 @@
 // The legs of a fitted body (systems/character/ellipsoid_fit.hpp, LegFit): each thigh and
 // each shin bone carries one fitted ellipsoid (no thin pieces overlapping in creases), and
 // with tight legs each shin bone also a sphere centred on its joint, the knee sphere; the
-// fitted pieces keep to the budget, the knee spheres come on top.
+// fitted pieces keep to the budget (grown by tight_extra_ellipsoids with tight legs), the
+// knee spheres come on top.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -18,6 +19,11 @@ inline bool is_knee_sphere(const EllipsoidShape& e) {
            e.radii_m.y() == e.radii_m.z();
 }
 
+// The fitted pieces a body may have: the budget, grown with tight legs.
+inline std::size_t fitted_budget(const CharacterBody& body, const FitOptions& options) {
+    return static_cast<std::size_t>(options.max_ellipsoids + (body.legs == LegFit::tight ? options.tight_extra_ellipsoids : 0));
+}
+
 inline void expect_legs(const CharacterBody& body, const FitOptions& options) {
     const auto count = [&](auto&& pred) { return std::count_if(body.ellipsoids.begin(), body.ellipsoids.end(), pred); };
     const auto knees = count(is_knee_sphere);
@@ -31,7 +37,7 @@ inline void expect_legs(const CharacterBody& body, const FitOptions& options) {
             return shin.bone == knee.bone && !is_knee_sphere(shin);
         })) << "a knee sphere sits on a shin bone";
     }
-    EXPECT_LE(body.ellipsoids.size() - static_cast<std::size_t>(knees), static_cast<std::size_t>(options.max_ellipsoids));
+    EXPECT_LE(body.ellipsoids.size() - static_cast<std::size_t>(knees), fitted_budget(body, options));
 }
 
 }  // namespace drape::test
