@@ -31,8 +31,9 @@
 // vertices within 1 cm), else bounded: the humans fitted so far are covered (99.9-100 %,
 // p95 bulge 1.6-2.0 cm against 3.5-7.3 cm bounded); RobotExpressive is not either way
 // (97.2 %, its plates), and its dress holds its springs on the bounded legs (docs/cloth.md,
-// "Known limits"). The bulge is not part of the choice: Male_Casual's 2.0 cm sits on its
-// target, where rounding would decide. Up to a centimetre of thigh skin lies outside the tight ellipsoids; the skin
+// "Known limits"). The bulge is not part of the choice: a fit near its target is decided
+// by rounding. A tight fit may use `tight_extra_ellipsoids` more pieces than the budget:
+// with the legs hugged the trunk's pieces decide the bulge. Up to a centimetre of thigh skin lies outside the tight ellipsoids; the skin
 // cover system draws it inside them (systems/skin_cover_system.hpp).
 //
 // Measures (measure_coverage):
