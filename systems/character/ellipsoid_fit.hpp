@@ -33,8 +33,9 @@
 // (97.2 %, its plates), and its dress holds its springs on the bounded legs (docs/cloth.md,
 // "Known limits"). The bulge is not part of the choice: a fit near its target is decided
 // by rounding. A tight fit may use `tight_extra_ellipsoids` more pieces than the budget:
-// with the legs hugged the trunk's pieces decide the bulge. Up to a centimetre of thigh skin lies outside the tight ellipsoids; the skin
-// cover system draws it inside them (systems/skin_cover_system.hpp).
+// with the legs hugged the trunk's pieces decide the bulge. Up to a centimetre of thigh
+// skin lies outside the tight ellipsoids; the skin cover system draws it inside them
+// (systems/skin_cover_system.hpp).
 //
 // Measures (measure_coverage):
 //  - coverage: the share of skin vertices inside some ellipsoid or within `tolerance_m` of
@@ -108,7 +109,8 @@ struct FitOptions {
 /// merge first when over budget); `meshes` (CharacterAsset::meshes) tell which vertices
 /// belong to rigid objects. `legs`, when given, receives the leg fit used (tight or
 /// bounding; with LegFit::automatic the tight fit is made first, and the bounding one too
-/// when the tight misses its targets). Deterministic: the same input gives the same shapes.
+/// when the tight one does not cover the skin: covers_skin). Deterministic: the same input
+/// gives the same shapes.
 [[nodiscard]] std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh,
                                                          Real height_m, const FitOptions& options = {},
                                                          std::span<const std::shared_ptr<const AnimationClip>> clips = {},
