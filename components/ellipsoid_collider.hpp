@@ -29,6 +29,7 @@ struct EllipsoidShape {
     Quat rotation = Quat::Identity();  ///< Bone space -> ellipsoid axes.
     Vec3 radii_m = Vec3::Constant(0.1f);
     BodyRegion region = BodyRegion::other;
+    Real give_m = 0;                   ///< See EllipsoidCollider::give_m.
 };
 
 struct EllipsoidCollider {
@@ -39,6 +40,11 @@ struct EllipsoidCollider {
     Quat rotation = Quat::Identity();
     Vec3 radii_m = Vec3::Constant(0.1f);
     BodyRegion region = BodyRegion::other;
+    /// How deep cloth may lie inside this ellipsoid where it meets one that does not give,
+    /// m (0: none). Where a forearm's or a hand's ellipsoid overlaps the hips' but its skin
+    /// does not, cloth caught between them keeps to the ellipsoid that does not give. The
+    /// fit gives forearms and hands their bulge over the skin (ellipsoid_fit.hpp).
+    Real give_m = 0;
 
     // World state, written by the collider system once per fixed step.
     Affine3 world = Affine3::Identity();           ///< Unit sphere -> world (translation * rotation * scale).

@@ -55,6 +55,7 @@ Result<void> apply_collider_overrides(Registry& registry, Entity character, std:
             if (o.center_m) c.center = *o.center_m;
             if (o.radii_m) c.radii_m = *o.radii_m;
             if (o.rotation_deg) c.rotation = euler_deg(*o.rotation_deg);
+            if (o.give_m) c.give_m = *o.give_m;
             c.initialised = false;
         }
     }

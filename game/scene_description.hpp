@@ -87,6 +87,7 @@ struct ColliderOverride {
     std::optional<Vec3> center_m;                        ///< Bone space.
     std::optional<Vec3> radii_m;
     std::optional<Vec3> rotation_deg;                    ///< Bone space, yaw * pitch * roll.
+    std::optional<Real> give_m;                          ///< EllipsoidCollider::give_m.
     SourceLocation where;
     friend bool operator==(const ColliderOverride&, const ColliderOverride&) = default;
 };

@@ -503,10 +503,11 @@ ColliderOverride read_collider(const Reader& r, const std::string& path, const J
     if (const Json* v = f.get("center_m")) c.center_m = read_vec3(r, f.path("center_m"), *v, -10, 10);
     if (const Json* v = f.get("radii_m")) c.radii_m = read_vec3(r, f.path("radii_m"), *v, 0, 10, Bound::open);
     if (const Json* v = f.get("rotation_deg")) c.rotation_deg = read_vec3(r, f.path("rotation_deg"), *v, -3600, 3600);
-    if (c.remove && (c.center_m || c.radii_m || c.rotation_deg))
+    if (const Json* v = f.get("give_m")) c.give_m = static_cast<Real>(read_real(r, f.path("give_m"), *v, 0, 0.5));
+    if (c.remove && (c.center_m || c.radii_m || c.rotation_deg || c.give_m))
         r.fail_at(f.path("remove"), "an override either removes the bone's ellipsoid or reshapes it, not both");
-    if (!c.remove && !c.center_m && !c.radii_m && !c.rotation_deg)
-        r.fail_at(path, "sets nothing: give center_m, radii_m or rotation_deg, or \"remove\": true");
+    if (!c.remove && !c.center_m && !c.radii_m && !c.rotation_deg && !c.give_m)
+        r.fail_at(path, "sets nothing: give center_m, radii_m, rotation_deg or give_m, or \"remove\": true");
     f.finish();
     return c;
 }
@@ -699,6 +700,7 @@ std::string to_json(const SceneDescription& scene) {
             if (c.center_m) o["center_m"] = vec(*c.center_m);
             if (c.radii_m) o["radii_m"] = vec(*c.radii_m);
             if (c.rotation_deg) o["rotation_deg"] = vec(*c.rotation_deg);
+            if (c.give_m) o["give_m"] = *c.give_m;
             colliders.push_back(std::move(o));
         }
         j["colliders"] = std::move(colliders);

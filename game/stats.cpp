@@ -33,6 +33,7 @@ void GarmentWatch::sample(const Registry& registry) {
         GarmentStats& w = t.worst;
         worse(w.strain_max, q.strain_max);
         worse(w.penetration_after_frame_m, q.penetration_m);
+        worse(w.within_give_m, q.within_give_m);
         worse(w.pins_inside_m, q.pins_inside_m);
         worse(w.rise_above_pins_m, q.rise_above_pins_m);
         worse(w.penetration_before_response_m, g->counters.max_penetration_m);
@@ -87,7 +88,8 @@ std::string stats_json(const RunStats& stats) {
                             {"strain", {{"max", number(g.strain_max)}, {"p99", number(g.strain_p99)}}},
                             {"penetration_m",
                              {{"after_frame_max", number(g.penetration_after_frame_m)},
-                              {"before_response_max", number(g.penetration_before_response_m)}}},
+                              {"before_response_max", number(g.penetration_before_response_m)},
+                              {"within_give_max", number(g.within_give_m)}}},
                             {"pins_inside_m", number(g.pins_inside_m)},
                             {"rise_above_pins_m", number(g.rise_above_pins_m)},
                             {"nonfinite", g.nonfinite},

@@ -5,7 +5,7 @@
 //    "systems": {NAME: {"runs", "skips", "mean_ms", "p50_ms", "p95_ms", "max_ms"}},
 //    "garments": [{"particles",
 //                  "strain": {"max", "p99"},
-//                  "penetration_m": {"after_frame_max", "before_response_max"},
+//                  "penetration_m": {"after_frame_max", "before_response_max", "within_give_max"},
 //                  "pins_inside_m", "rise_above_pins_m", "nonfinite", "resets",
 //                  "collision_tests_per_frame", "max_strain", "max_penetration_m"}]}
 //
@@ -13,6 +13,8 @@
 // frame (systems/cloth/garment_quality.hpp) and are the worst seen over the run, except
 // `strain.p99`: the 99th percentile over every spring of every frame. `max_strain` and
 // `max_penetration_m` repeat `strain.max` and `penetration_m.before_response_max`.
+// Penetration counts the depth past an ellipsoid's give (EllipsoidCollider::give_m);
+// `within_give_max` is the deepest a free particle lay inside a giving ellipsoid within it.
 #pragma once
 
 #include <cstdint>
@@ -33,7 +35,8 @@ struct GarmentStats {
     std::uint64_t particles = 0;
     double strain_max = 0;               ///< Largest strain of a structural spring with a free end after a frame.
     double strain_p99 = 0;               ///< 99th percentile of those strains over every frame.
-    double penetration_after_frame_m = 0;///< Deepest free particle inside an ellipsoid after a frame.
+    double penetration_after_frame_m = 0;///< Deepest free particle inside an ellipsoid after a frame (past its give).
+    double within_give_m = 0;            ///< Deepest free particle inside a giving ellipsoid, within its give, after a frame.
     double penetration_before_response_m = 0; ///< Deepest penetration the collision found before moving a particle out.
     double pins_inside_m = 0;            ///< Deepest pinned particle inside an ellipsoid after a frame.
     double rise_above_pins_m = 0;        ///< Highest free particle above the highest pin after a frame.

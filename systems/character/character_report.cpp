@@ -66,9 +66,10 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
     out += format("  ellipsoids  %zu fitted, legs %s\n", body.ellipsoids.size(), leg_fit_name(body.legs));
     for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {
         const EllipsoidShape& e = body.ellipsoids[i];
-        out += format("    %-20s %-10s radii %.3f %.3f %.3f m  bulge %.3f m\n", s.bone_names[std::size_t(e.bone)].c_str(),
+        out += format("    %-20s %-10s radii %.3f %.3f %.3f m  bulge %.3f m%s\n", s.bone_names[std::size_t(e.bone)].c_str(),
                       body_region_name(e.region), double(e.radii_m.x()), double(e.radii_m.y()), double(e.radii_m.z()),
-                      i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0);
+                      i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0,
+                      e.give_m > 0 ? format("  give %.3f m", double(e.give_m)).c_str() : "");
     }
     out += format("  coverage    %.1f %% of %zu vertices inside or within %.0f mm (largest gap %.3f m)\n", 100 * r.coverage,
                   r.vertices, 1000 * r.tolerance_m, r.max_gap_m);
@@ -123,7 +124,8 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
                                    {"center", {e.center.x(), e.center.y(), e.center.z()}},
                                    {"rotation", {e.rotation.x(), e.rotation.y(), e.rotation.z(), e.rotation.w()}},
                                    {"radii_m", {e.radii_m.x(), e.radii_m.y(), e.radii_m.z()}},
-                                   {"bulge_m", i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0}});
+                                   {"bulge_m", i < r.bulge_per_ellipsoid_m.size() ? r.bulge_per_ellipsoid_m[i] : 0.0},
+                                   {"give_m", e.give_m}});
     }
     j["coverage"] = {{"share", r.coverage}, {"vertices", r.vertices}, {"covered", r.covered}, {"tolerance_m", r.tolerance_m},
                      {"max_gap_m", r.max_gap_m}, {"mean_bulge_m", r.mean_bulge_m}, {"p95_bulge_m", r.p95_bulge_m},

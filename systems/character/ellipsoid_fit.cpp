@@ -573,24 +573,33 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
                                            const FitOptions& options,
                                            std::span<const std::shared_ptr<const AnimationClip>> clips,
                                            std::span<const MeshInfo> meshes, LegFit* legs) {
-    if (options.legs != LegFit::automatic) {
-        if (legs) *legs = options.legs;
-        return fit_with(skeleton, mesh, height_m, options, clips, meshes, options.legs == LegFit::tight);
-    }
-    // Automatic: the tight legs where the whole fit then covers the skin to the target at the
-    // rest pose (covers_skin).
-    std::vector<EllipsoidShape> tight = fit_with(skeleton, mesh, height_m, options, clips, meshes, true);
     std::vector<Affine3> global, skinning;
     compose_pose(skeleton, skeleton.rest_local, global);
     skinning_matrices(skeleton, global, skinning);
     Matrix3X positions, normals;
     skin_mesh(mesh, skinning, Affine3::Identity(), positions, normals);
-    if (covers_skin(measure_coverage(tight, global, positions, normals, mesh.indices, options.tolerance_m), options)) {
-        if (legs) *legs = LegFit::tight;
-        return tight;
+    const auto measure = [&](std::span<const EllipsoidShape> shapes) {
+        return measure_coverage(shapes, global, positions, normals, mesh.indices, options.tolerance_m);
+    };
+    LegFit used = options.legs;
+    std::vector<EllipsoidShape> shapes = fit_with(skeleton, mesh, height_m, options, clips, meshes, options.legs != LegFit::bounding);
+    CoverageReport report = measure(shapes);
+    if (options.legs == LegFit::automatic) {
+        // The tight legs where the whole fit then covers the skin to the target at the rest
+        // pose (covers_skin).
+        used = LegFit::tight;
+        if (!covers_skin(report, options)) {
+            used = LegFit::bounding;
+            shapes = fit_with(skeleton, mesh, height_m, options, clips, meshes, false);
+            report = measure(shapes);
+        }
     }
-    if (legs) *legs = LegFit::bounding;
-    return fit_with(skeleton, mesh, height_m, options, clips, meshes, false);
+    if (legs) *legs = used;
+    // Forearms and hands give by their bulge over the skin (EllipsoidCollider::give_m).
+    for (std::size_t i = 0; i < shapes.size() && i < report.bulge_per_ellipsoid_m.size(); ++i)
+        if (shapes[i].region == BodyRegion::lower_arm || shapes[i].region == BodyRegion::hand)
+            shapes[i].give_m = static_cast<Real>(report.bulge_per_ellipsoid_m[i]);
+    return shapes;
 }
 
 Affine3 ellipsoid_transform(const EllipsoidShape& shape, const Affine3& bone_global) {
@@ -746,6 +755,12 @@ Result<std::vector<EllipsoidShape>> ellipsoids_from_json(std::string_view json_t
             const auto r = item["region"].is_string() ? region_from_string(item["region"].get<std::string>()) : std::nullopt;
             if (!r) return fail(at + ": " + field + ".region: unknown region (head, neck, torso, pelvis, upper_arm, lower_arm, hand, upper_leg, lower_leg, foot, other)");
             s.region = *r;
+        }
+        if (item.contains("give_m")) {
+            const auto& g = item["give_m"];
+            if (!g.is_number() || !std::isfinite(g.get<double>()) || g.get<double>() < 0 || g.get<double>() >= s.radii_m.minCoeff())
+                return fail(at + ": " + field + ".give_m: must be a number from 0 up to (not including) the smallest radius");
+            s.give_m = static_cast<Real>(g.get<double>());
         }
         shapes.push_back(s);
     }

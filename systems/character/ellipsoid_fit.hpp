@@ -37,6 +37,9 @@
 // skin lies outside the tight ellipsoids; the skin cover system draws it inside them
 // (systems/skin_cover_system.hpp).
 //
+// Give: each forearm and hand gives by its bulge over the skin at the rest pose (the
+// largest, bulge_per_ellipsoid_m; EllipsoidCollider::give_m), every other piece none.
+//
 // Measures (measure_coverage):
 //  - coverage: the share of skin vertices inside some ellipsoid or within `tolerance_m` of
 //    one (the exact distance to the ellipsoid's surface);
@@ -157,8 +160,8 @@ struct CoverageReport {
 [[nodiscard]] const char* leg_fit_name(LegFit legs) noexcept;
 
 /// Reads manual ellipsoids from JSON text: an array of
-/// `{"bone": "Hips", "center": [x,y,z], "radii_m": [a,b,c], "rotation": [x,y,z,w], "region": "pelvis"}`
-/// (rotation and region optional). `source` names the text in errors (a scene file path).
+/// `{"bone": "Hips", "center": [x,y,z], "radii_m": [a,b,c], "rotation": [x,y,z,w], "region": "pelvis", "give_m": 0}`
+/// (rotation, region and give optional; give_m: EllipsoidCollider::give_m, none by default). `source` names the text in errors (a scene file path).
 [[nodiscard]] Result<std::vector<EllipsoidShape>> ellipsoids_from_json(std::string_view json_text,
                                                                       const SkeletonAsset& skeleton,
                                                                       std::string_view source);

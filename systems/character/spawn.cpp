@@ -76,6 +76,7 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
         collider.rotation = s.rotation;
         collider.radii_m = s.radii_m;
         collider.region = s.region;
+        collider.give_m = s.give_m;
         // World transform valid at once; velocities start with the first step.
         update_collider(collider, registry.get<Skeleton>(e), &registry.get<Transform>(e), 0);
         collider.initialised = false;

@@ -42,6 +42,8 @@ EllipsoidFrame interpolate_collider(const EllipsoidCollider& collider, Real alph
     frame.velocity_m_s = collider.velocity_m_s;
     frame.acceleration_m_s2 = collider.acceleration_m_s2;
     frame.angular_velocity_rad_s = collider.angular_velocity_rad_s;
+    // In world units: scaled as the radii are (a character's Transform may carry a scale).
+    if (collider.give_m > 0 && collider.radii_m.sum() > 0) frame.give_m = collider.give_m * frame.radii_m.sum() / collider.radii_m.sum();
     return frame;
 }
 

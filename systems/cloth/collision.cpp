@@ -192,6 +192,34 @@ inline Real clearance_of(Real y0, Real y1, Real y2, Real r0, Real r1, Real r2, R
     return std::max(r_min * (std::sqrt(y0 * y0 + y1 * y1 + y2 * y2) - 1), box);
 }
 
+// ---- Give (EllipsoidCollider::give_m): how deep a point may lie inside giving ellipsoid
+// `f`, its give less the point's distance outside the nearest ellipsoid of `holds` (those
+// that do not give; a lower bound of the distance, clearance_of): the whole give on their
+// surface, none a give away from them. Cloth caught between a forearm and the hips then
+// keeps to the hips, inside the forearm's bulge, instead of being squeezed out of both.
+inline Real give_allowance(std::span<const EllipsoidFrame> frames, std::uint64_t holds, const EllipsoidFrame& f, const Vec3& x) {
+    Real gap = std::numeric_limits<Real>::infinity();
+    for_each_bit(holds, [&](int h) {
+        const EllipsoidFrame& t = frames[static_cast<std::size_t>(h)];
+        const Vec3 y = t.to_unit * (x - t.center);
+        gap = std::min(gap, clearance_of(y[0], y[1], y[2], t.radii_m[0], t.radii_m[1], t.radii_m[2], t.radii_m.minCoeff()));
+    });
+    return f.give_m - std::clamp(gap, Real(0), f.give_m);
+}
+
+// A point within this of its allowance counts as outside: a push onto the allowance moves
+// the point and with it the allowance, and the re-test rounds would chase it.
+constexpr Real give_tolerance_m = Real(1e-4);
+
+// The masks of the active frames that give and of those that hold.
+inline std::pair<std::uint64_t, std::uint64_t> give_masks(std::span<const EllipsoidFrame> frames, std::uint64_t active) {
+    std::uint64_t gives = 0;
+    for_each_bit(active, [&](int e) {
+        if (frames[static_cast<std::size_t>(e)].give_m > 0) gives |= std::uint64_t(1) << e;
+    });
+    return {gives, active & ~gives};
+}
+
 // The reference ellipsoids of a list update as structure of arrays, lane e = ellipsoid e,
 // so that one point is tested against all of them in a few vector instructions (a
 // particle's whole list refresh). A lane without an active ellipsoid holds one 1e18 m away
@@ -435,6 +463,14 @@ inline Vec3 fallback_exit(std::span<const EllipsoidFrame> frames, std::uint64_t 
 
 }  // namespace
 
+Real depth_past_give(std::span<const EllipsoidFrame> frames, std::size_t e, const Vec3& x) {
+    const EllipsoidFrame& f = frames[e];
+    const Real depth = penetration_depth(f, x);
+    if (depth <= 0 || f.give_m <= 0) return depth;
+    const auto [gives, holds] = give_masks(frames, active_mask(frames));
+    return std::max(Real(0), depth - give_allowance(frames, holds, f, x));
+}
+
 Real penetration_depth(const EllipsoidFrame& f, const Vec3& x) {
     const Vec3 d = x - f.center;
     const Real y_sq = (f.to_unit * d).squaredNorm();
@@ -502,6 +538,11 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
     const std::uint64_t active = active_mask(frames);
     std::array<Real, 64> outside{};  // per ellipsoid: 1 + surface_clearance, once per pass
     for_each_bit(active, [&](int e) { outside[static_cast<std::size_t>(e)] = 1 + surface_clearance(frames[static_cast<std::size_t>(e)]); });
+    const auto [gives, holds] = give_masks(frames, active);
+    // How deep the particle at `xp` may lie inside ellipsoid e (0 unless e gives).
+    const auto allowance = [&](int e, const Vec3& xp) {
+        return (gives >> e & 1) != 0 ? give_allowance(frames, holds, frames[static_cast<std::size_t>(e)], xp) : Real(0);
+    };
 
     // Response for one particle and the ellipsoids `hits` (not empty) found to contain it.
     auto collide_one = [&](Eigen::Index p, std::uint64_t hits) {
@@ -512,7 +553,7 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
         // The first contact answered is measured on the way (below); any other at the detected place.
         const int first = std::countr_zero((hits & last) != 0 ? hits & last : hits);
         for_each_bit(hits & ~(std::uint64_t(1) << first), [&](int e) {
-            r.max_penetration_m = std::max(r.max_penetration_m, penetration_depth(frames[static_cast<std::size_t>(e)], xp));
+            r.max_penetration_m = std::max(r.max_penetration_m, penetration_depth(frames[static_cast<std::size_t>(e)], xp) - allowance(e, xp));
         });
         if (detected) (*detected)[pi] = hits;
         last_collided[pi] = hits;
@@ -530,8 +571,13 @@ CollisionResult collide_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_m
             const Real y_len = std::sqrt(y_sq);
             const Real inv_len = 1 / y_len;
             const Real depth = centre_line_depth(f, d, y_len, inv_len);
-            if (responses == 0 && e == first) r.max_penetration_m = std::max(r.max_penetration_m, depth);
-            last_y_surface = place_shortest(f, y, y_sq, inv_len, depth, xp, outside[static_cast<std::size_t>(e)]);
+            const Real allowed = y_len > Real(1e-6) ? allowance(e, xp) : Real(0);
+            if (depth <= allowed + give_tolerance_m && allowed > 0) return false;
+            if (responses == 0 && e == first) r.max_penetration_m = std::max(r.max_penetration_m, depth - allowed);
+            if (allowed > 0)  // along the centre line to the allowance: |d| / |y| metres per unit of |y|
+                last_y_surface = place_on_surface(f, y, xp, 1 - allowed * y_len / d.norm());
+            else
+                last_y_surface = place_shortest(f, y, y_sq, inv_len, depth, xp, outside[static_cast<std::size_t>(e)]);
             last_e = e;
             ++responses;
             ++r.collisions;

@@ -35,6 +35,11 @@
 //      beyond what the list bound still covers); after a few rounds it leaves from where it
 //      was detected by the shortest of a few straight ways out past every ellipsoid, one of
 //      them toward the particle above it on its warp line (the cloth it hangs from).
+//      An ellipsoid that gives (EllipsoidCollider::give_m: a forearm's or a hand's bulge
+//      over its skin) leaves a particle inside it where it lies no deeper than its give less
+//      the particle's distance outside the nearest ellipsoid that does not give (a lower
+//      bound, the list clearance below); a particle deeper goes along the centre line to
+//      that depth. Cloth caught between a forearm and the hips keeps to the hips.
 //      Within a substep, a particle that collided takes the velocity of its whole move,
 //      (x_end - x_start) / h, before the normal component is removed: the constraints
 //      and the push-out then cannot pump energy into a particle held against the body.
@@ -57,6 +62,11 @@ namespace drape {
 
 /// Distance the centre-line response would move `x` out of the ellipsoid (0 when outside), m.
 [[nodiscard]] Real penetration_depth(const EllipsoidFrame& f, const Vec3& x);
+
+/// How far x lies inside ellipsoid `frames[e]` past what its give allows there
+/// (EllipsoidCollider::give_m: the give less x's distance outside the nearest active
+/// ellipsoid that does not give); penetration_depth for an ellipsoid without give.
+[[nodiscard]] Real depth_past_give(std::span<const EllipsoidFrame> frames, std::size_t e, const Vec3& x);
 
 /// The nearest place outside the ellipsoid for a point inside it, by the shortest of the
 /// normal and the centre line (the contact response's rule), plus the clearance; a point

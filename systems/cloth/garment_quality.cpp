@@ -61,8 +61,10 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
     for (Eigen::Index i = 0; i < x.cols(); ++i)
         if (w[i] != 0 && std::isfinite(highest_pin) && std::isfinite(x(1, i)))
             q.rise_above_pins_m = std::max(q.rise_above_pins_m, x(1, i) - highest_pin);
-    // Depths: each ellipsoid against the particles in its bounding box only.
-    for (const EllipsoidFrame& f : frames) {
+    // Depths: each ellipsoid against the particles in its bounding box only; past its give
+    // where it gives (collision.hpp), the depth within the give kept apart.
+    for (std::size_t e = 0; e < frames.size(); ++e) {
+        const EllipsoidFrame& f = frames[e];
         if (!f.active) continue;
         const Vec3 half = f.rotation.cwiseAbs() * f.radii_m;
         const Vec3 low = f.center - half, high = f.center + half;
@@ -70,8 +72,11 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
             const Vec3 p = x.col(i);
             if ((p.array() < low.array()).any() || (p.array() > high.array()).any()) continue;  // NaN too: counted above
             const Real depth = penetration_depth(f, p);
+            if (depth <= 0) continue;
+            const Real past = f.give_m > 0 ? depth_past_give(frames, e, p) : depth;
             Real& worst = w[i] == 0 ? q.pins_inside_m : q.penetration_m;
-            worst = std::max(worst, depth);
+            worst = std::max(worst, past);
+            if (w[i] != 0) q.within_give_m = std::max(q.within_give_m, depth - past);
         }
     }
     return q;

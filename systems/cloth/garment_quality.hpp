@@ -7,7 +7,9 @@
 //   spring (warp of both layers, weft) with at least one free end: between two pinned
 //   particles the skin decides.
 // - Depth inside an ellipsoid: how far the centre-line response would move the particle out
-//   (collision.hpp penetration_depth), an upper bound of its distance to the surface.
+//   (collision.hpp penetration_depth), an upper bound of its distance to the surface; for an
+//   ellipsoid that gives (EllipsoidCollider::give_m), the depth past what its give allows
+//   there (depth_past_give), the depth within the give reported apart.
 // - Rise above the pins: the largest height of a free particle above the highest pinned
 //   particle, along world up (+Y); 0 when none is higher.
 #pragma once
@@ -27,7 +29,8 @@ namespace drape {
 struct GarmentQuality {
     Real strain_max = 0;            ///< Largest strain of a spring with a free end.
     Real strain_p99 = 0;            ///< Its 99th percentile over those springs.
-    Real penetration_m = 0;         ///< Deepest free particle inside an ellipsoid.
+    Real penetration_m = 0;         ///< Deepest free particle inside an ellipsoid (past its give).
+    Real within_give_m = 0;         ///< Deepest free particle inside an ellipsoid within its give.
     Real pins_inside_m = 0;         ///< Deepest pinned particle inside an ellipsoid.
     Real rise_above_pins_m = 0;     ///< See the conventions above.
     std::uint64_t nonfinite = 0;    ///< Non-finite coordinates in x and v.

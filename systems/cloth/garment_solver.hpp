@@ -29,6 +29,7 @@ struct EllipsoidFrame {
     Vec3 acceleration_m_s2 = Vec3::Zero();
     Vec3 angular_velocity_rad_s = Vec3::Zero();
     bool active = false;               ///< False when the collider entity is gone: never tested.
+    Real give_m = 0;                   ///< EllipsoidCollider::give_m in world units (collision.hpp, "Give").
 };
 
 /// The candidate lists of one particle range (garment_parts.hpp): each range keeps its own

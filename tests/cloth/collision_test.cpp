@@ -191,6 +191,63 @@ std::array<std::uint64_t, 3> compare_with_brute_force(ClothModel model, const Dr
 // Detection tests blocks of 64 particles in vector lanes; it must agree with the single
 // unit-sphere test for every particle, including a last block that is not full and pinned
 // particles (never reported).
+// A hip (a sphere that does not give) and a forearm (a sphere with 3 cm of give) that
+// overlap by 2 cm, as a fitted forearm's bulge overlaps the hips where its skin does not.
+std::vector<EllipsoidFrame> hip_and_forearm(Real give_m) {
+    std::vector<EllipsoidFrame> frames;
+    for (const auto [centre, radius] : {std::pair{Real(0), Real(0.15)}, std::pair{Real(0.19), Real(0.06)}}) {
+        Affine3 t = Affine3::Identity();
+        t.translate(Vec3(centre, 1, 0));
+        t.scale(radius);
+        frames.push_back(make_ellipsoid_frame(t));
+    }
+    frames[1].give_m = give_m;
+    return frames;
+}
+
+// Collides one free particle at `start` against `frames`; returns where it ends.
+Vec3 collide_alone(const std::vector<EllipsoidFrame>& frames, const Vec3& start) {
+    Matrix3X x(3, 1), v = Matrix3X::Zero(3, 1);
+    x.col(0) = start;
+    std::vector<std::uint64_t> last;
+    const CollisionResult r = collide_particles(x, v, VectorX::Ones(1), frames, nullptr, last);
+    EXPECT_EQ(r.unresolved, 0u);
+    return x.col(0);
+}
+
+TEST(Collision, CaughtBetweenTheHipsAndAForearmThatGivesClothKeepsToTheHips) {
+    const Vec3 caught(0.14f, 1, 0);  // 1 cm inside the hip, 1 cm inside the forearm
+    // With give: onto the hip's surface, left inside the forearm within its give.
+    const std::vector<EllipsoidFrame> giving = hip_and_forearm(0.03f);
+    const Vec3 kept = collide_alone(giving, caught);
+    EXPECT_NEAR((kept - giving[0].center).norm(), 0.15f, 1e-4);
+    EXPECT_EQ(penetration_depth(giving[0], kept), 0);
+    EXPECT_GT(penetration_depth(giving[1], kept), 0.015f);
+    EXPECT_LE(depth_past_give(giving, 1, kept), 1e-4);
+    EXPECT_LT((kept - caught).norm(), 0.011f);
+    // Without: squeezed out of both, farther from where it was.
+    const std::vector<EllipsoidFrame> hard = hip_and_forearm(0);
+    const Vec3 squeezed = collide_alone(hard, caught);
+    for (const EllipsoidFrame& f : hard) EXPECT_LE(penetration_depth(f, squeezed), 1e-5);
+    EXPECT_GT((squeezed - caught).norm(), 0.03f);
+}
+
+TEST(Collision, AGivingEllipsoidGivesOnlyNearOneThatDoesNot) {
+    const std::vector<EllipsoidFrame> frames = hip_and_forearm(0.03f);
+    // 9 cm outside the hip, 1 cm inside the forearm: no give that far out, pushed out whole.
+    const Vec3 far = collide_alone(frames, Vec3(0.24f, 1, 0));
+    EXPECT_EQ(penetration_depth(frames[1], far), 0);
+    EXPECT_EQ(depth_past_give(frames, 1, Vec3(0.24f, 1, 0)), penetration_depth(frames[1], Vec3(0.24f, 1, 0)));
+    // 1 cm outside the hip, 2 cm inside the forearm: its give there is 3 - 1 = 2 cm.
+    const Vec3 near(0.16f, 1, 0.01f);
+    EXPECT_NEAR(penetration_depth(frames[1], near) - depth_past_give(frames, 1, near), 0.02f, 0.002f);
+    const Vec3 out = collide_alone(frames, near);
+    EXPECT_LE(depth_past_give(frames, 1, out), 1e-4);
+    EXPECT_EQ(penetration_depth(frames[0], out), 0);
+    // A hip alone gives nothing: depth_past_give is its depth.
+    EXPECT_EQ(depth_past_give(frames, 0, Vec3(0.1f, 1, 0)), penetration_depth(frames[0], Vec3(0.1f, 1, 0)));
+}
+
 TEST(Collision, BlockDetectionAgreesWithTheUnitSphereTestOfEachParticle) {
     std::vector<EllipsoidFrame> frames{tilted_ellipsoid()};
     Affine3 t = Affine3::Identity();

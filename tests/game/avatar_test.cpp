@@ -315,6 +315,16 @@ void expect_fitted_ellipsoids(const CharacterAsset& c, const std::string& what, 
     EXPECT_LE(coverage.p95_bulge_m, legs == LegFit::bounding ? bounding_fit_p95_bulge_bound_m : 0.02)
         << "max bulge " << coverage.max_bulge_m << " m";
     EXPECT_EQ(body->legs, legs == LegFit::automatic ? LegFit::tight : legs);
+    // Forearms and hands give by their bulge over the skin at the rest pose, nothing else.
+    ASSERT_EQ(coverage.bulge_per_ellipsoid_m.size(), body->ellipsoids.size());
+    int giving = 0;
+    for (std::size_t i = 0; i < body->ellipsoids.size(); ++i) {
+        const EllipsoidShape& e = body->ellipsoids[i];
+        const bool arm = e.region == BodyRegion::lower_arm || e.region == BodyRegion::hand;
+        EXPECT_NEAR(e.give_m, arm ? coverage.bulge_per_ellipsoid_m[i] : 0.0, 1e-6) << "ellipsoid " << i;
+        giving += e.give_m > 0;
+    }
+    EXPECT_GT(giving, 0);  // some arm piece stands out of its skin (one that does not gives nothing)
 }
 
 void expect_hugging_ellipsoids(const CharacterAsset& c, const std::string& what) {

@@ -42,7 +42,7 @@ RunStats example() {
     r.systems.push_back(s);
     r.characters.push_back({.file = "assets/avatar.glb", .clip = "Walk", .height_m = 1.75});
     r.garments.push_back({.particles = 837, .strain_max = 0.1, .strain_p99 = 0.05, .penetration_after_frame_m = 0.0001,
-                          .penetration_before_response_m = 0.004, .pins_inside_m = 0.002, .rise_above_pins_m = 0.01,
+                          .within_give_m = 0.02, .penetration_before_response_m = 0.004, .pins_inside_m = 0.002, .rise_above_pins_m = 0.01,
                           .nonfinite = 0, .resets = 1, .collision_tests_per_frame = 1234.5});
     return r;
 }
@@ -70,9 +70,10 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
                                                  "particles", "penetration_m", "pins_inside_m", "resets", "rise_above_pins_m",
                                                  "strain"}));
     EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99"}));
-    EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max"}));
+    EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max", "within_give_max"}));
     EXPECT_DOUBLE_EQ(g["strain"]["p99"].get<double>(), 0.05);
     EXPECT_DOUBLE_EQ(g["penetration_m"]["before_response_max"].get<double>(), 0.004);
+    EXPECT_DOUBLE_EQ(g["penetration_m"]["within_give_max"].get<double>(), 0.02);
     EXPECT_EQ(g["resets"], 1);
     EXPECT_EQ(g["particles"], 837);
     EXPECT_DOUBLE_EQ(g["collision_tests_per_frame"].get<double>(), 1234.5);
