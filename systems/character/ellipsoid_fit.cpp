@@ -596,9 +596,10 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
     }
     if (legs) *legs = used;
     // Forearms and hands give by their bulge over the skin (EllipsoidCollider::give_m).
-    for (std::size_t i = 0; i < shapes.size() && i < report.bulge_per_ellipsoid_m.size(); ++i)
-        if (shapes[i].region == BodyRegion::lower_arm || shapes[i].region == BodyRegion::hand)
-            shapes[i].give_m = static_cast<Real>(report.bulge_per_ellipsoid_m[i]);
+    if (report.bulge_per_ellipsoid_m.size() == shapes.size())  // one per shape: every fitted bone is in the skeleton
+        for (std::size_t i = 0; i < shapes.size(); ++i)
+            if (shapes[i].region == BodyRegion::lower_arm || shapes[i].region == BodyRegion::hand)
+                shapes[i].give_m = static_cast<Real>(report.bulge_per_ellipsoid_m[i]);
     return shapes;
 }
 
