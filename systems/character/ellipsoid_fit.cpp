@@ -759,8 +759,8 @@ Result<std::vector<EllipsoidShape>> ellipsoids_from_json(std::string_view json_t
         }
         if (item.contains("give_m")) {
             const auto& g = item["give_m"];
-            if (!g.is_number() || !std::isfinite(g.get<double>()) || g.get<double>() < 0 || g.get<double>() >= s.radii_m.minCoeff())
-                return fail(at + ": " + field + ".give_m: must be a number from 0 up to (not including) the smallest radius");
+            if (!g.is_number() || !std::isfinite(g.get<double>()) || g.get<double>() < 0 || g.get<double>() > 0.5)
+                return fail(at + ": " + field + ".give_m: must be a number in [0, 0.5] m");
             s.give_m = static_cast<Real>(g.get<double>());
         }
         shapes.push_back(s);

@@ -161,7 +161,7 @@ struct CoverageReport {
 
 /// Reads manual ellipsoids from JSON text: an array of
 /// `{"bone": "Hips", "center": [x,y,z], "radii_m": [a,b,c], "rotation": [x,y,z,w], "region": "pelvis", "give_m": 0}`
-/// (rotation, region and give optional; give_m: EllipsoidCollider::give_m, none by default). `source` names the text in errors (a scene file path).
+/// (rotation, region and give optional; give_m in [0, 0.5] m as in scene files: EllipsoidCollider::give_m, none by default). `source` names the text in errors (a scene file path).
 [[nodiscard]] Result<std::vector<EllipsoidShape>> ellipsoids_from_json(std::string_view json_text,
                                                                       const SkeletonAsset& skeleton,
                                                                       std::string_view source);

@@ -165,6 +165,13 @@ TEST(EllipsoidFitting, OverridesFromJsonReplaceTheFittedShapeOfTheirBone) {
     bad = ellipsoids_from_json(R"([{"bone": "Child", "center": [0,0,0], "radii_m": [1,0,1]}])", *c->skeleton, "scene.json");
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().message, "scene.json: colliders[0].radii_m: must be > 0");
+    // The give has the scene files' range: a flat hand's fitted give may pass its thickness.
+    auto give = ellipsoids_from_json(R"([{"bone": "Child", "center": [0,0,0], "radii_m": [0.02,0.1,0.1], "give_m": 0.03}])", *c->skeleton, "scene.json");
+    ASSERT_TRUE(give) << give.error().message;
+    EXPECT_FLOAT_EQ((*give)[0].give_m, 0.03f);
+    bad = ellipsoids_from_json(R"([{"bone": "Child", "center": [0,0,0], "radii_m": [1,1,1], "give_m": 0.6}])", *c->skeleton, "scene.json");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().message, "scene.json: colliders[0].give_m: must be a number in [0, 0.5] m");
 }
 
 TEST(CharacterSystems, SpawnedCharacterAnimatesSkinsAndMovesItsColliders) {
