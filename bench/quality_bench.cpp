@@ -11,8 +11,8 @@
 // - Shape: every particle's distance from the same particle of the converged reference
 //   (bench/reference.hpp: classic model, brute-force collision, fine fixed substeps, the same
 //   motion) over short horizons restarted from the reference's state.
-// - From other points of the clip: the shipped model's cases run from several starts of
-//   the clip (the walks are chaotic; one run is one sample): how many keep the contract.
+// - From other points of the clip: every case run from several starts of the clip (the
+//   walks are chaotic; one run is one sample): how many keep the contract.
 // - A contact sheet: frames across one walk cycle of each case, rendered off-screen (only in
 //   a build with the render module).
 #include <algorithm>
@@ -94,10 +94,11 @@ struct Row {
     bool is_default() const { return model == GarmentDescription{}.model; }
 };
 
-/// The shipped model's case run from different points of the clip: the walks are chaotic,
-/// so one run's worst spring is one sample of what a user may see.
+/// A case run from different points of the clip: the walks are chaotic, so one run's worst
+/// spring is one sample of what a user may see.
 struct PhaseRow {
     GarmentType garment = GarmentType::skirt;
+    ClothModel model = ClothModel::simplified;
     const CharacterCase* character = nullptr;
     std::string error;
     std::vector<double> starts_s;
@@ -208,10 +209,10 @@ Result<void> measure_stats(Row& row, int runs, int threads) {
     return {};
 }
 
-/// The shipped model's after-frame stats from `phase_starts` points of the clip.
+/// After-frame stats from `phase_starts` points of the clip.
 Result<void> measure_phases(PhaseRow& row, int threads) {
     for (int k = 0; k < phase_starts; ++k) {
-        SceneDescription scene = case_scene(*row.character, row.garment, GarmentDescription{}.model, GarmentDescription{}.collision, 0, threads);
+        SceneDescription scene = case_scene(*row.character, row.garment, row.model, GarmentDescription{}.collision, 0, threads);
         scene.characters.at(0).start_s = phase_step_s * k;
         auto world = build_world(scene, {});
         if (!world) return fail(world.error().message);
@@ -378,21 +379,23 @@ Result<void> run_quality(const BenchOptions& options) {
             }
         }
 
-    // The shipped model from other points of the clip.
+    // Every case from other points of the clip.
     std::vector<PhaseRow> phases;
     for (GarmentType garment : {GarmentType::skirt, GarmentType::dress})
-        for (const CharacterCase& c : cases) {
-            PhaseRow row;
-            row.garment = garment;
-            row.character = &c;
-            std::fprintf(stderr, "drape bench quality: %s on %s from %d points of the clip\n", garment_type_name(garment),
-                         c.name.c_str(), phase_starts);
-            if (auto ok = measure_phases(row, options.threads); !ok) {
-                if (c.default_avatar) return fail("quality: " + ok.error().message);
-                row.error = ok.error().message;
+        for (const CharacterCase& c : cases)
+            for (ClothModel model : {ClothModel::simplified, ClothModel::classic}) {
+                PhaseRow row;
+                row.garment = garment;
+                row.model = model;
+                row.character = &c;
+                std::fprintf(stderr, "drape bench quality: %s %s on %s from %d points of the clip\n", garment_type_name(garment),
+                             short_name(model), c.name.c_str(), phase_starts);
+                if (auto ok = measure_phases(row, options.threads); !ok) {
+                    if (c.default_avatar) return fail("quality: " + ok.error().message);
+                    row.error = ok.error().message;
+                }
+                phases.push_back(std::move(row));
             }
-            phases.push_back(std::move(row));
-        }
 
     // The contact sheets (one per garment).
     std::string sheet_error;
@@ -475,7 +478,7 @@ Result<void> run_quality(const BenchOptions& options) {
     json["phases"] = nlohmann::json::array();
     for (const PhaseRow& p : phases) {
         nlohmann::json j = {{"garment", garment_type_name(p.garment)},
-                            {"model", short_name(GarmentDescription{}.model)},
+                            {"model", short_name(p.model)},
                             {"character", p.character->name},
                             {"frames", p.character->stats_frames}};
         if (!p.error.empty()) {
@@ -590,18 +593,19 @@ Result<void> run_quality(const BenchOptions& options) {
     report.paragraph(
         "The walks are chaotic: a difference in rounding (another compiler, the sanitizers) or in the starting pose "
         "sends a run elsewhere, and a garment caught in a crease the body closes (behind a bent knee, where small "
-        "pieces meet) may tear in one run and not in the next. So each case of the shipped model (" +
-        std::string(short_name(GarmentDescription{}.model)) + ") is also run from " + std::to_string(phase_starts) +
+        "pieces meet) may tear in one run and not in the next. So each case is also run from " + std::to_string(phase_starts) +
         " points of its clip, " + fixed(phase_step_s, 3) + " s apart (`start_s` 0 to " +
         fixed(phase_step_s * (phase_starts - 1), 3) + " s), over the same frames as above: how many runs keep the "
         "contract of their character (strain p99, max and penetration after the frame, as in the targets), and the "
         "worst spring of each run.");
     std::vector<std::vector<std::string>> phase_table;
     for (const PhaseRow& p : phases) {
-        std::vector<std::string> cells = {garment_type_name(p.garment), p.character->name};
+        std::vector<std::string> cells = {garment_type_name(p.garment),
+                                          std::string(short_name(p.model)) + (p.model == GarmentDescription{}.model ? " (default)" : ""),
+                                          p.character->name};
         if (!p.error.empty()) {
             cells.push_back("could not run: " + p.error);
-            cells.resize(5, "");
+            cells.resize(6, "");
             phase_table.push_back(cells);
             continue;
         }
@@ -617,7 +621,7 @@ Result<void> run_quality(const BenchOptions& options) {
         cells.push_back(worst);
         phase_table.push_back(cells);
     }
-    report.table({"garment", "character", "runs within the contract", "median worst spring (%)", "worst spring per start (%)"},
+    report.table({"garment", "model", "character", "runs within the contract", "median worst spring (%)", "worst spring per start (%)"},
                  phase_table);
 
     report.heading("Reference convergence");
