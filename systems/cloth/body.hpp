@@ -35,6 +35,14 @@ void update_frames(const Registry& registry, const GarmentBody& body, std::vecto
 /// Rigid frame (rotation + centre, no scale) of the anchor collider among `frames`, or identity.
 [[nodiscard]] Affine3 anchor_frame(std::span<const EllipsoidFrame> frames, std::int32_t anchor);
 
+/// Arms and hands hang outside a garment: a free particle inside an arm's or a hand's
+/// ellipsoid (of `frames`, one per entry of `body.colliders`), on the limb's far side from
+/// the anchor's centre, goes in, level (world up is +y), toward that centre until it is
+/// outside every arm and hand, so that the collision that follows does not wrap the cloth
+/// round the limb. For a rest shape put round a body in some pose (placement, reset).
+void tuck_under_limbs(const Registry& registry, const GarmentBody& body, std::span<const EllipsoidFrame> frames, Matrix3X& x,
+                      const VectorX& inv_mass);
+
 /// Velocity of the body point at `x` carried by `frame`'s rigid motion: v_c + w x (x - c).
 [[nodiscard]] inline Vec3 body_velocity_at(const EllipsoidFrame& frame, const Vec3& x) {
     return frame.velocity_m_s + frame.angular_velocity_rad_s.cross(x - frame.center);

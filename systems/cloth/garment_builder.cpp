@@ -208,46 +208,6 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
     return pin;
 }
 
-// Arms and hands hang outside a garment. The rest shape is placed round the trunk and may
-// put cloth inside a forearm or a hand hanging at the side; pushed out the shortest way,
-// cloth on the limb's far side from the body would wrap round the outside of it, the limb
-// inside the garment, and tear as it swung (Male_Casual's dress started at four points of
-// his walk: 74-280 %). Such a particle goes in instead, level, toward the anchor's centre,
-// until it is outside every limb: under the arm. Cloth on the limb's near side is left to
-// the collision, whose shortest way already leads in.
-void tuck_under_limbs(Registry& registry, const Garment& g, std::span<const EllipsoidFrame> frames, Matrix3X& x,
-                      const VectorX& inv_mass) {
-    if (g.body.anchor < 0) return;
-    std::vector<std::size_t> limbs;
-    for (std::size_t e = 0; e < g.body.colliders.size(); ++e) {
-        const BodyRegion r = registry.get<EllipsoidCollider>(g.body.colliders[e]).region;
-        if ((r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand) && frames[e].active) limbs.push_back(e);
-    }
-    const Vec3 centre = frames[static_cast<std::size_t>(g.body.anchor)].center;
-    const auto level = [](Vec3 v) { v.y() = 0; return v; };
-    for (Eigen::Index p = 0; p < x.cols(); ++p) {
-        if (inv_mass[p] == 0) continue;
-        for (int pass = 0; pass < 4; ++pass) {   // out of one limb, maybe into the next
-            bool moved = false;
-            for (const std::size_t e : limbs) {
-                const EllipsoidFrame& f = frames[e];
-                const Vec3 u0 = f.to_unit * (x.col(p) - f.center);
-                if (u0.squaredNorm() >= 1) continue;
-                if (level(x.col(p) - centre).norm() < level(f.center - centre).norm()) continue;  // the near side
-                const Vec3 in = level(centre - x.col(p));
-                if (in.norm() < Real(1e-6)) continue;
-                const Vec3 d = in.normalized();
-                // Where the level ray leaves the ellipsoid: |u0 + t w| = 1.
-                const Vec3 w = f.to_unit * d;
-                const Real a = w.squaredNorm(), b = u0.dot(w), c = u0.squaredNorm() - 1;
-                x.col(p) += ((-b + std::sqrt(b * b - a * c)) / a + Real(1e-3)) * d;
-                moved = true;
-            }
-            if (!moved) break;
-        }
-    }
-}
-
 // Pins `rows` rows, pushes the rest out of the colliders, records the rest shape, and
 // adds the garment to the registry.
 Result<Entity> finish(Registry& registry, Garment g, int rows) {
@@ -265,7 +225,7 @@ Result<Entity> finish(Registry& registry, Garment g, int rows) {
     for (const PinBinding& pin : state.pins)
         if (auto at = evaluate_pin(registry, g, pin)) state.x.col(pin.particle) = *at;
     prepare_solver(g, solver);
-    tuck_under_limbs(registry, g, solver.frames, state.x, state.inv_mass);
+    tuck_under_limbs(registry, g.body, solver.frames, state.x, state.inv_mass);
     std::vector<std::uint64_t> last;
     for (int pass = 0; pass < 4; ++pass) collide_particles(state.x, state.v, state.inv_mass, solver.frames, nullptr, last);
     state.v.setZero();

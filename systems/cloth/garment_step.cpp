@@ -584,6 +584,7 @@ void reset_garment_state(const Registry& registry, Garment& g, GarmentSolver& s)
         const std::uint32_t p = state.pins[i].particle;
         state.x.col(p) = s.pin_target.col(static_cast<Eigen::Index>(i));
     }
+    tuck_under_limbs(registry, g.body, s.frames, state.x, state.inv_mass);
     std::fill(s.last_collided.begin(), s.last_collided.end(), 0);
     s.lists.valid = false;
     s.anchor_known = false;

@@ -195,7 +195,7 @@ std::array<std::uint64_t, 3> compare_with_brute_force(ClothModel model, const Dr
 // overlap by 2 cm, as a fitted forearm's bulge overlaps the hips where its skin does not.
 std::vector<EllipsoidFrame> hip_and_forearm(Real give_m) {
     std::vector<EllipsoidFrame> frames;
-    for (const auto [centre, radius] : {std::pair{Real(0), Real(0.15)}, std::pair{Real(0.19), Real(0.06)}}) {
+    for (const auto& [centre, radius] : {std::pair{Real(0), Real(0.15)}, std::pair{Real(0.19), Real(0.06)}}) {
         Affine3 t = Affine3::Identity();
         t.translate(Vec3(centre, 1, 0));
         t.scale(radius);
