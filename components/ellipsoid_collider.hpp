@@ -22,6 +22,19 @@ enum class BodyRegion : std::uint8_t {
 };
 [[nodiscard]] const char* body_region_name(BodyRegion region) noexcept;
 
+/// An upper arm, a forearm or a hand.
+[[nodiscard]] constexpr bool is_arm(BodyRegion r) noexcept {
+    return r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand;
+}
+
+/// A thigh, a shin or a foot.
+[[nodiscard]] constexpr bool is_leg(BodyRegion r) noexcept {
+    return r == BodyRegion::upper_leg || r == BodyRegion::lower_leg || r == BodyRegion::foot;
+}
+
+/// What a skirt or a dress leaves outside: the arms and the head.
+[[nodiscard]] constexpr bool hangs_outside_garments(BodyRegion r) noexcept { return is_arm(r) || r == BodyRegion::head; }
+
 /// An ellipsoid in bone space: what fitting produces and a scene file may override.
 struct EllipsoidShape {
     int bone = -1;                     ///< Index into SkeletonAsset.

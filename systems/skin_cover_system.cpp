@@ -17,16 +17,12 @@
 namespace drape {
 namespace {
 
-bool free_limb(BodyRegion r) {
-    return r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::head;
-}
-
 // Per bone of the character: true for the bones of an arm, a hand or the head (from its
 // colliders' regions) and every bone below them.
 std::vector<bool> free_limb_bones(Registry& registry, Entity character, const SkeletonAsset& skeleton) {
     std::vector<bool> limb(skeleton.size(), false);
     registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
-        if (c.character == character && free_limb(c.region) && c.bone >= 0 && static_cast<std::size_t>(c.bone) < limb.size())
+        if (c.character == character && hangs_outside_garments(c.region) && c.bone >= 0 && static_cast<std::size_t>(c.bone) < limb.size())
             limb[static_cast<std::size_t>(c.bone)] = true;
     });
     for (std::size_t b = 0; b < limb.size(); ++b) {  // parents come first

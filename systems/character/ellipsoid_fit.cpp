@@ -364,10 +364,7 @@ std::vector<EllipsoidShape> fit_with(const SkeletonAsset& skeleton, const MeshAs
     // the first of them.
     auto region_of = [&](std::size_t b) { return region_from_bone_name(skeleton.bone_names[b]); };
     auto extremity = [](BodyRegion r) { return r == BodyRegion::hand || r == BodyRegion::foot; };
-    auto limb = [](BodyRegion r) {
-        return r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::upper_leg ||
-               r == BodyRegion::lower_leg || r == BodyRegion::foot;
-    };
+    auto limb = [](BodyRegion r) { return is_arm(r) || is_leg(r); };
     auto move = [&](std::size_t from, std::size_t to) {
         auto& target = clusters[to];
         target.insert(target.end(), clusters[from].begin(), clusters[from].end());

@@ -253,8 +253,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
         const auto& c = registry.get<EllipsoidCollider>(e);
         placed = placed || c.initialised;
         frames.push_back(make_ellipsoid_frame(c.world));
-        const BodyRegion r = c.region;
-        limb.push_back(r == BodyRegion::upper_arm || r == BodyRegion::lower_arm || r == BodyRegion::hand || r == BodyRegion::head);
+        limb.push_back(hangs_outside_garments(c.region));
     }
     if (!placed) return fail(p + ": the character's colliders have not been placed yet (run the collider system once)");
 
