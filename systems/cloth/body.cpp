@@ -1,9 +1,10 @@
 // Collider frames for the cloth (method §2, §5); see body.hpp for conventions.
 #include "systems/cloth/body.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <vector>
+#include <bit>
+#include <cstdint>
+
+#include "systems/cloth/collision.hpp"
 
 namespace drape {
 
@@ -81,14 +82,12 @@ Affine3 anchor_frame(std::span<const EllipsoidFrame> frames, std::int32_t anchor
 void tuck_under_limbs(const Registry& registry, const GarmentBody& body, std::span<const EllipsoidFrame> frames, Matrix3X& x,
                       const VectorX& inv_mass) {
     if (body.anchor < 0 || static_cast<std::size_t>(body.anchor) >= frames.size()) return;
-    std::vector<std::size_t> limbs;
-    for (std::size_t e = 0; e < body.colliders.size() && e < frames.size(); ++e) {
+    std::uint64_t arms = 0;
+    for (std::size_t e = 0; e < body.colliders.size() && e < frames.size() && e < 64; ++e) {
         const auto* c = registry.try_get<EllipsoidCollider>(body.colliders[e]);
-        if (c && frames[e].active &&
-            (c->region == BodyRegion::upper_arm || c->region == BodyRegion::lower_arm || c->region == BodyRegion::hand))
-            limbs.push_back(e);
+        if (c && frames[e].active && is_arm(c->region)) arms |= std::uint64_t(1) << e;
     }
-    if (limbs.empty()) return;
+    if (arms == 0) return;
     const Vec3 centre = frames[static_cast<std::size_t>(body.anchor)].center;
     const auto level = [](Vec3 v) {
         v.y() = 0;
@@ -96,24 +95,16 @@ void tuck_under_limbs(const Registry& registry, const GarmentBody& body, std::sp
     };
     for (Eigen::Index p = 0; p < x.cols(); ++p) {
         if (inv_mass[p] == 0) continue;
-        for (int pass = 0; pass < 4; ++pass) {  // out of one limb, maybe into the next
-            bool moved = false;
-            for (const std::size_t e : limbs) {
-                const EllipsoidFrame& f = frames[e];
-                const Vec3 u0 = f.to_unit * (x.col(p) - f.center);
-                if (u0.squaredNorm() >= 1) continue;
-                if (level(x.col(p) - centre).norm() < level(f.center - centre).norm()) continue;  // the near side
-                const Vec3 in = level(centre - x.col(p));
-                if (in.norm() < Real(1e-6)) continue;
-                const Vec3 d = in.normalized();
-                // Where the level ray leaves the ellipsoid: |u0 + t w| = 1.
-                const Vec3 w = f.to_unit * d;
-                const Real a = w.squaredNorm(), b = u0.dot(w), c = u0.squaredNorm() - 1;
-                x.col(p) += ((-b + std::sqrt(b * b - a * c)) / a + Real(1e-3)) * d;
-                moved = true;
-            }
-            if (!moved) break;
+        const Vec3 at = x.col(p);
+        bool far_side = false;
+        for (std::uint64_t bits = arms; bits != 0 && !far_side; bits &= bits - 1) {
+            const EllipsoidFrame& f = frames[static_cast<std::size_t>(std::countr_zero(bits))];
+            far_side = to_unit_sphere(f, at).squaredNorm() < 1 && level(at - centre).norm() >= level(f.center - centre).norm();
         }
+        const Vec3 in = level(centre - at);
+        if (!far_side || in.norm() < Real(1e-6)) continue;
+        const Vec3 d = in.normalized();
+        x.col(p) = at + first_point_outside(frames, arms, at, d) * d;
     }
 }
 

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <span>
+#include <vector>
 
 #include "components/ellipsoid_collider.hpp"
 #include "components/garment.hpp"

@@ -381,8 +381,10 @@ std::uint64_t refresh_bit(const Matrix3XRows& x, Eigen::Index first, Eigen::Inde
     return tests;
 }
 
+}  // namespace
+
 // Entry and exit distances of the ray o + t d (|d| = 1) through the ellipsoid; in > out if it misses.
-inline std::pair<Real, Real> ray_span(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
+std::pair<Real, Real> ray_span(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     const Eigen::Vector3d oo = to_unit_sphere(f, o).cast<double>();
     const Eigen::Vector3d dd = (f.to_unit * d).cast<double>();
     const double a = dd.squaredNorm(), b = 2 * oo.dot(dd), c = oo.squaredNorm() - 1;
@@ -392,11 +394,10 @@ inline std::pair<Real, Real> ray_span(const EllipsoidFrame& f, const Vec3& o, co
     return {static_cast<Real>((-b - root) / (2 * a)), static_cast<Real>((-b + root) / (2 * a))};
 }
 
-// Smallest t >= 0 at which o + t d is outside every ellipsoid of `set`. Each is convex, so the
-// ray is inside it on one interval: step past every interval that covers t until none does
-// (each interval is passed at most once). Stops early once t exceeds `give_up`.
-inline Real first_point_outside(std::span<const EllipsoidFrame> frames, std::uint64_t set, const Vec3& o,
-                                const Vec3& d, Real give_up) {
+// Each ellipsoid is convex, so the ray is inside it on one interval: step past every interval
+// that covers t until none does (each interval is passed at most once).
+Real first_point_outside(std::span<const EllipsoidFrame> frames, std::uint64_t set, const Vec3& o, const Vec3& d,
+                         Real give_up) {
     Real t = 0;
     for (int pass = 0; pass <= 64 && t <= give_up; ++pass) {
         bool advanced = false;
@@ -412,6 +413,8 @@ inline Real first_point_outside(std::span<const EllipsoidFrame> frames, std::uin
     }
     return t;
 }
+
+namespace {
 
 // Way out for a particle the re-test rounds could not free: from `x` (where it was detected),
 // along the shortest of the outward normals and centre lines of the ellipsoids it was found

@@ -49,6 +49,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "components/garment.hpp"
@@ -72,6 +73,16 @@ namespace drape {
 /// normal and the centre line (the contact response's rule), plus the clearance; a point
 /// outside is returned as it is.
 [[nodiscard]] Vec3 leave_ellipsoid(const EllipsoidFrame& f, const Vec3& x);
+
+/// Entry and exit distances of the ray o + t d (|d| = 1) through the ellipsoid; in > out
+/// where the ray misses it.
+[[nodiscard]] std::pair<Real, Real> ray_span(const EllipsoidFrame& f, const Vec3& o, const Vec3& d);
+
+/// The smallest t >= 0 at which o + t d (|d| = 1) lies outside every ellipsoid of `frames`
+/// in the bit set `set` (active ones only), plus the clearance past the last one it leaves;
+/// it stops early once t exceeds `give_up`.
+[[nodiscard]] Real first_point_outside(std::span<const EllipsoidFrame> frames, std::uint64_t set, const Vec3& o,
+                                       const Vec3& d, Real give_up = std::numeric_limits<Real>::infinity());
 
 /// Moves x onto the surface along the centre line and removes the normal velocity
 /// relative to the surface (method §5). `y` = to_unit_sphere(f, x), |y| < 1.
