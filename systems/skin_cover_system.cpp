@@ -75,7 +75,7 @@ std::uint64_t pull_in(std::span<const EllipsoidFrame> frames, const SkinCover& c
         Real scale = 1;
         bool inside = false;
         for (const EllipsoidFrame& f : frames) {
-            if (!f.active) continue;
+            if (!f.active || f.give_m > 0) continue;  // cloth may lie inside one that gives
             const Vec3 d = x - f.center;
             const Real y = (f.to_unit * d).norm();
             if (y <= 1 - skin_cover_inset) {  // already as deep as a pulled vertex is drawn

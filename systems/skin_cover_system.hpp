@@ -12,6 +12,10 @@
 // particles that lie on the ellipsoids, which cut a little inside a curved surface, and
 // skin just under the surface (where the legs' tight ellipsoids hug it) showed through
 // them. Skin farther out is left alone: it is not the body under the cloth (a hand, a bag).
+// Only the ellipsoids that do not give count, as inside and as the nearest: cloth may lie
+// inside a forearm's or a hand's ellipsoid, within its give (EllipsoidCollider::give_m), but
+// never inside the others, so skin drawn in those is under the cloth. Counted, the arms let
+// hip skin by a hand hanging at the side (Female_Alternative's) show through her dress.
 //
 // Covered: the vertices whose strongest bone is neither an arm, a hand nor the head (nor a
 // bone below them), and that lay between the garment's hem and its highest pin when the
