@@ -303,7 +303,39 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     if (outline.empty())
         return fail(p + ": no collider crosses the ring height " + number(ring_y) + " m near the body axis");
 
-    const int n = s.warp_lines, m = s.particles_per_line;
+    // The ring's radius toward d (level, unit): where the ray leaves the body outline, plus
+    // the ease; 0 where the outline does not surround the axis.
+    const auto ring_radius = [&](const Vec3& d) {
+        Real r = -1;
+        for (std::size_t e : outline) r = std::max(r, ray_exit(frames[e], origin, d));
+        // Between two legs hugged apart (a ring below the crotch) a ray may pass every
+        // collider: the line then stands on the body's hull, as far as the colliders reach.
+        if (r <= 0)
+            for (std::size_t e : outline) r = std::max(r, support_distance(frames[e], origin, d));
+        return r <= 0 ? Real(0) : r + s.ease_m;
+    };
+    const auto direction = [](Real theta) { return Vec3(std::sin(theta), 0, std::cos(theta)); };
+    // More lines on a wider body: at most line_spacing_m apart round the ring (perimeter
+    // sampled at ring_samples directions), a multiple of weft_stride.
+    int n = s.warp_lines;
+    if (s.line_spacing_m > 0) {
+        constexpr int ring_samples = 64;
+        Real perimeter = 0;
+        Vec3 last = origin + direction(0) * ring_radius(direction(0));
+        for (int k = 1; k <= ring_samples; ++k) {
+            const Vec3 d = direction(Real(2) * std::numbers::pi_v<Real> * Real(k) / Real(ring_samples));
+            const Vec3 at = origin + d * ring_radius(d);
+            perimeter += (at - last).norm();
+            last = at;
+        }
+        const int needed = static_cast<int>(std::ceil(perimeter / s.line_spacing_m / Real(s.weft_stride))) * s.weft_stride;
+        n = std::max(n, needed);
+        if (n * s.particles_per_line > max_garment_particles)
+            return fail(field(p, "line_spacing_m") + ": " + number(s.line_spacing_m) + " m round a ring of " + number(perimeter) +
+                        " m needs " + std::to_string(n) + " lines, more than " + std::to_string(max_garment_particles) +
+                        " particles in all");
+    }
+    const int m = s.particles_per_line;
     const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;
     // The hem above the ankles: a dress made for one body must not reach into the feet (or
     // through the floor) of a shorter one.
@@ -319,15 +351,9 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     Matrix3X grid(3, n * m);
     for (int line = 0; line < n; ++line) {
         const Real theta = Real(2) * std::numbers::pi_v<Real> * Real(line) / Real(n);
-        const Vec3 d(std::sin(theta), 0, std::cos(theta));
-        Real r = -1;
-        for (std::size_t e : outline) r = std::max(r, ray_exit(frames[e], origin, d));
-        // Between two legs hugged apart (a ring below the crotch) a ray may pass every
-        // collider: the line then stands on the body's hull, as far as the colliders reach.
-        if (r <= 0)
-            for (std::size_t e : outline) r = std::max(r, support_distance(frames[e], origin, d));
+        const Vec3 d = direction(theta);
+        const Real r = ring_radius(d);
         if (r <= 0) return fail(p + ": the body outline at the ring height does not surround the axis");
-        r += s.ease_m;
         // Down the cone, but never closer to the axis than the body below the ring (hips,
         // thighs, bust) plus the ease: the rest shape must fit over the body, or the cloth
         // would hang stretched over it. Once widened, the line keeps its width below.

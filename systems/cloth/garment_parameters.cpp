@@ -116,6 +116,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
                 "particles down each line; `warp_lines` x `particles_per_line` is at most the `particles` limit"),
         integer("weft_stride", &TubeParams::weft_stride, closed(1, max_side - 1),
                 "every n-th line is integrated, the lines between are placed (method §3.2); less than `warp_lines`"),
+        real("line_spacing_m", &TubeParams::line_spacing_m, closed(0, 1), "m",
+             "> 0: on a wider body more lines, at most this far apart round the ring (never fewer than `warp_lines`); 0: `warp_lines` as given"),
         real("length_m", &TubeParams::length_m, open_min(0, 10), "m", "from the ring to the hem, along the cloth"),
         real("hem_clearance_fraction", &TubeParams::hem_clearance_fraction, open_max(0, 1), "",
              "the hem stays at least this x body height above the body's lowest point: `length_m` is shortened on a shorter body (0: never)"),

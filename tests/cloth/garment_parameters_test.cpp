@@ -23,11 +23,12 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
     // Every ClothMaterial field a garment carries is a row (9 of them), and so is every
-    // numeric field of TubeParams (13, the inertia scales and the hem clearance included).
+    // numeric field of TubeParams (14, the inertia scales, the hem clearance and the line
+    // spacing included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
     EXPECT_EQ(material, 9);
-    EXPECT_EQ(garment_parameters().size(), 22u);
+    EXPECT_EQ(garment_parameters().size(), 23u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {

@@ -21,10 +21,13 @@
 namespace drape {
 namespace {
 
+// The paper's grid, as given (line_spacing_m 0: no lines added on a wider body).
 TEST(Builders, DefaultSkirtHas837ParticlesIn27WarpLinesOf31) {
     Registry registry;
     test::AnalyticBody body(registry);
-    const auto e = attach_skirt(registry, body.character, TubeParams::skirt());
+    TubeParams params = TubeParams::skirt();
+    params.line_spacing_m = 0;
+    const auto e = attach_skirt(registry, body.character, params);
     ASSERT_TRUE(e) << e.error().message;
     const Garment& g = registry.get<Garment>(*e);
     EXPECT_EQ(g.state.x.cols(), 837);
@@ -43,6 +46,49 @@ TEST(Builders, DefaultSkirtHas837ParticlesIn27WarpLinesOf31) {
     for (Eigen::Index p = 0; p < g.state.x.cols(); ++p)
         for (Entity c : g.body.colliders)
             EXPECT_LE(penetration_depth(make_ellipsoid_frame(registry.get<EllipsoidCollider>(c).world), g.state.x.col(p)), 1e-5);
+}
+
+// Round a wider waist, more lines: at most line_spacing_m apart round the ring, a multiple
+// of weft_stride, never fewer than warp_lines. The analytic body's ring (about 0.82 m round)
+// needs 30 lines 2.9 cm apart; a spacing of 10 cm leaves the 27.
+TEST(Builders, AWiderRingGetsMoreLines) {
+    // The ring's perimeter through the pinned row (a polygon through the lines, so a little
+    // shorter than the ring it samples).
+    const auto ring_perimeter = [](const Garment& g) {
+        const std::uint32_t n = g.fabric->warp_lines, m = g.fabric->particles_per_line;
+        Real perimeter = 0;
+        for (std::uint32_t line = 0; line < n; ++line)
+            perimeter += (g.state.x.col(g.fabric->grid[((line + 1) % n) * m]) - g.state.x.col(g.fabric->grid[line * m])).norm();
+        return perimeter;
+    };
+    for (const Real spacing : {Real(0.029), Real(0.1)}) {
+        Registry registry;
+        test::AnalyticBody body(registry);
+        TubeParams params = TubeParams::skirt();
+        params.line_spacing_m = spacing;
+        const auto e = attach_skirt(registry, body.character, params);
+        ASSERT_TRUE(e) << e.error().message;
+        const Garment& g = registry.get<Garment>(*e);
+        const std::uint32_t lines = g.fabric->warp_lines;
+        EXPECT_EQ(lines % 3, 0u);
+        EXPECT_EQ(g.state.x.cols(), static_cast<Eigen::Index>(lines * 31));
+        const Real perimeter = ring_perimeter(g);
+        EXPECT_LE(perimeter / Real(lines), spacing) << lines << " lines round " << perimeter << " m";
+        if (spacing < Real(0.05)) {
+            EXPECT_GT(lines, 27u);
+            EXPECT_GT(perimeter / Real(lines - 3), spacing) << "three lines fewer would do";
+        } else {
+            EXPECT_EQ(lines, 27u);
+        }
+    }
+    // A spacing the particle limit cannot meet is refused with the field's name.
+    Registry registry;
+    test::AnalyticBody body(registry);
+    TubeParams params = TubeParams::skirt();
+    params.line_spacing_m = Real(1e-5);
+    const auto e = attach_skirt(registry, body.character, params);
+    ASSERT_FALSE(e);
+    EXPECT_NE(e.error().message.find("skirt.line_spacing_m"), std::string::npos) << e.error().message;
 }
 
 TEST(Builders, DressScalesPastTenThousandParticles) {
