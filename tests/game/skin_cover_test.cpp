@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -82,43 +83,38 @@ struct CoverFigures {
     Real deepest_before_m = 0;    ///< The farthest of those.
 };
 
-// Walks `scene`'s character `frames` frames, skins its mesh, runs the cover, and checks
-// every vertex: a covered one within reach outside the garment's body, or inside it less
-// deep than skin_cover_inset, ends inside it; every other one (uncovered, deep enough
-// inside, or farther out) is drawn where skinning put it.
-CoverFigures check_cover(const SceneDescription& scene, int frames) {
-    CoverFigures figures;
-    auto world = build_world(scene, {});
-    EXPECT_TRUE(world) << world.error().message;
-    if (!world) return figures;
-    for (int frame = 0; frame < frames; ++frame) EXPECT_TRUE(step_world(*world, 1.0 / 60.0));
-    skin_characters(world->registry);
-    SkinnedMesh& skin = world->registry.get<SkinnedMesh>(world->characters.at(0));
+// Skins `world`'s character where it is now, runs the cover, and checks every vertex: a
+// covered one within reach outside the garment's body, or inside it less deep than
+// skin_cover_inset, ends inside it; every other one (uncovered, deep enough inside, or
+// farther out) is drawn where skinning put it. Adds to `figures`.
+void check_cover_now(World& world, CoverFigures& figures) {
+    skin_characters(world.registry);
+    SkinnedMesh& skin = world.registry.get<SkinnedMesh>(world.characters.at(0));
     const Matrix3X skinned = skin.positions;
-    cover_skin(world->registry);
-    const Garment& g = world->registry.get<Garment>(world->garments.at(0));
-    const SkinCover* cover = world->registry.try_get<SkinCover>(world->garments.at(0));
+    cover_skin(world.registry);
+    const Garment& g = world.registry.get<Garment>(world.garments.at(0));
+    const SkinCover* cover = world.registry.try_get<SkinCover>(world.garments.at(0));
     EXPECT_NE(cover, nullptr);
-    if (cover == nullptr) return figures;
+    if (cover == nullptr) return;
     std::vector<bool> covered(static_cast<std::size_t>(skinned.cols()), false);
     for (std::uint32_t v : cover->vertices) covered.at(v) = true;
     figures.covered = cover->vertices.size();
     for (Eigen::Index v = 0; v < skinned.cols(); ++v) {
-        const Real before = outside_garment_body(world->registry, g, skinned.col(v));
-        if (!covered[static_cast<std::size_t>(v)] || deep_in_garment_body(world->registry, g, skinned.col(v)) ||
+        const Real before = outside_garment_body(world.registry, g, skinned.col(v));
+        if (!covered[static_cast<std::size_t>(v)] || deep_in_garment_body(world.registry, g, skinned.col(v)) ||
             before > skin_cover_reach_m) {
             EXPECT_TRUE(skin.positions.col(v) == skinned.col(v)) << "vertex " << v << " moved";
             continue;
         }
         ++(before == 0 ? figures.shallow : figures.stood_out);
-        if (nearest_gives(world->registry, g, skinned.col(v))) ++figures.by_give;
+        if (nearest_gives(world.registry, g, skinned.col(v))) ++figures.by_give;
         figures.deepest_before_m = std::max(figures.deepest_before_m, before);
-        EXPECT_EQ(outside_garment_body(world->registry, g, skin.positions.col(v)), 0) << "vertex " << v;
+        EXPECT_EQ(outside_garment_body(world.registry, g, skin.positions.col(v)), 0) << "vertex " << v;
         EXPECT_LT((skin.positions.col(v) - skinned.col(v)).norm(), before + Real(0.02)) << "vertex " << v;
     }
     EXPECT_EQ(cover->pulled, figures.stood_out + figures.shallow);
     // Hands, arms and the head are never covered: the hands hang beside a skirt.
-    world->registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+    world.registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
         if (c.region != BodyRegion::hand && c.region != BodyRegion::head) return;
         const MeshAsset& mesh = *skin.mesh;
         for (std::uint32_t v : cover->vertices) {
@@ -127,11 +123,25 @@ CoverFigures check_cover(const SceneDescription& scene, int frames) {
             EXPECT_NE(mesh.bone_indices(strongest, v), c.bone) << "vertex " << v << " of a " << body_region_name(c.region);
         }
     });
+}
+
+// Walks `scene`'s character to each of `checks` (frame counts, rising) and checks the cover
+// there (check_cover_now); the figures add up over the checks.
+CoverFigures check_cover(const SceneDescription& scene, std::initializer_list<int> checks) {
+    CoverFigures figures;
+    auto world = build_world(scene, {});
+    EXPECT_TRUE(world) << world.error().message;
+    if (!world) return figures;
+    int frame = 0;
+    for (const int check : checks) {
+        for (; frame < check; ++frame) EXPECT_TRUE(step_world(*world, 1.0 / 60.0));
+        check_cover_now(*world, figures);
+    }
     return figures;
 }
 
 TEST(SkinCover, TheSampleSkirtCoversTheHipsAndThighs) {
-    const CoverFigures f = check_cover(sample_scene(), 30);
+    const CoverFigures f = check_cover(sample_scene(), {30});
     EXPECT_GT(f.covered, 500u);
     EXPECT_GT(f.shallow, 0u);  // the legs' tight ellipsoids lie just under the skin
     RecordProperty("covered", std::to_string(f.covered));
@@ -149,7 +159,7 @@ TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
         scene.characters[0].file = file;
         scene.garments.emplace_back();
         scene.garments[0].type = type;
-        const CoverFigures f = check_cover(scene, 30);
+        const CoverFigures f = check_cover(scene, {30});
         EXPECT_GT(f.stood_out, 50u);
         EXPECT_GT(f.deepest_before_m, Real(0.01));
         RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_stood_out_before",
@@ -160,7 +170,9 @@ TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
 // Female_Alternative's hands hang against her hips: hip skin by a hand lies nearer the
 // forearm's or the hand's ellipsoid than any other, and drawn just inside that one, where
 // cloth may lie too (within the give), it showed through her dress. It is drawn inside the
-// ellipsoids that do not give (check_cover: inside a firm one after the cover).
+// ellipsoids that do not give (check_cover: inside a firm one after the cover). Checked
+// through a walk cycle: which vertices lie by a hand depends on the fitted ellipsoids,
+// whose fit rounds differently in another build.
 TEST(SkinCover, HipSkinByAHandStaysUnderTheDress) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/female_alternative/Female_Alternative.fbx";
     DRAPE_REQUIRE_SHARED(file);
@@ -169,7 +181,7 @@ TEST(SkinCover, HipSkinByAHandStaysUnderTheDress) {
     scene.characters[0].file = file;
     scene.garments.emplace_back();
     scene.garments[0].type = GarmentType::dress;
-    const CoverFigures f = check_cover(scene, 90);
+    const CoverFigures f = check_cover(scene, {30, 45, 60, 75, 90, 105, 120});
     EXPECT_GT(f.by_give, 0u);
     RecordProperty("by_give", std::to_string(f.by_give));
 }
