@@ -328,12 +328,12 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
             perimeter += (at - last).norm();
             last = at;
         }
-        const int needed = static_cast<int>(std::ceil(perimeter / s.line_spacing_m / Real(s.weft_stride))) * s.weft_stride;
-        n = std::max(n, needed);
-        if (n * s.particles_per_line > max_garment_particles)
+        const double needed = std::ceil(double(perimeter) / s.line_spacing_m / s.weft_stride) * s.weft_stride;
+        if (!(needed <= 4096 && needed * s.particles_per_line <= max_garment_particles))
             return fail(field(p, "line_spacing_m") + ": " + number(s.line_spacing_m) + " m round a ring of " + number(perimeter) +
-                        " m needs " + std::to_string(n) + " lines, more than " + std::to_string(max_garment_particles) +
+                        " m needs " + number(needed) + " lines; at most 4096 lines and " + std::to_string(max_garment_particles) +
                         " particles in all");
+        n = std::max(n, static_cast<int>(needed));
     }
     const int m = s.particles_per_line;
     const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;

@@ -81,14 +81,17 @@ TEST(Builders, AWiderRingGetsMoreLines) {
             EXPECT_EQ(lines, 27u);
         }
     }
-    // A spacing the particle limit cannot meet is refused with the field's name.
-    Registry registry;
-    test::AnalyticBody body(registry);
-    TubeParams params = TubeParams::skirt();
-    params.line_spacing_m = Real(1e-5);
-    const auto e = attach_skirt(registry, body.character, params);
-    ASSERT_FALSE(e);
-    EXPECT_NE(e.error().message.find("skirt.line_spacing_m"), std::string::npos) << e.error().message;
+    // A spacing the line and particle limits cannot meet is refused with the field's name,
+    // however small.
+    for (const Real spacing : {Real(1e-4), Real(1e-5), Real(1e-30)}) {
+        Registry registry;
+        test::AnalyticBody body(registry);
+        TubeParams params = TubeParams::skirt();
+        params.line_spacing_m = spacing;
+        const auto e = attach_skirt(registry, body.character, params);
+        ASSERT_FALSE(e) << spacing;
+        EXPECT_NE(e.error().message.find("skirt.line_spacing_m"), std::string::npos) << e.error().message;
+    }
 }
 
 TEST(Builders, DressScalesPastTenThousandParticles) {
