@@ -47,7 +47,7 @@ constexpr double reference_tolerance_m = 1e-3;
 constexpr int sheet_phases = 6;         ///< Frames across one walk cycle.
 constexpr int sheet_warmup_frames = 60; ///< Before the first sheet frame.
 constexpr int tile_width = 240, tile_height = 300;
-constexpr int phase_starts = 8;         ///< Runs of the shipped model per case, started across the clip.
+constexpr int phase_starts = 8;         ///< Runs per case (garment, model, character), started across the clip.
 constexpr double phase_step_s = 0.125;  ///< Clip time between their starts.
 constexpr int render_scale = 2;         ///< Tiles are rendered this much larger and averaged down.
 
@@ -224,12 +224,20 @@ Result<void> measure_phases(PhaseRow& row, int threads) {
     return {};
 }
 
-Result<void> measure_shape(Row& row, const ConvergedReference& reference, int threads) {
-    auto world = case_world(*row.character, row.garment, row.model, GarmentDescription{}.collision, 0, threads);
+/// Shape RMS of `scene`'s garment from `reference`, over `c`'s horizons.
+Result<double> shape_rms(const SceneDescription& scene, const CharacterCase& c, const ConvergedReference& reference) {
+    auto world = build_world(scene, {});
     if (!world) return fail(world.error().message);
-    auto states = run_horizons(*world, row.character->plan, &reference.states);
+    auto states = run_horizons(*world, c.plan, &reference.states);
     if (!states) return fail(states.error().message);
-    row.shape_rms_m = horizon_rms_m(*states, reference.states);
+    return horizon_rms_m(*states, reference.states);
+}
+
+Result<void> measure_shape(Row& row, const ConvergedReference& reference, int threads) {
+    const auto rms = shape_rms(case_scene(*row.character, row.garment, row.model, GarmentDescription{}.collision, 0, threads),
+                               *row.character, reference);
+    if (!rms) return fail(rms.error().message);
+    row.shape_rms_m = *rms;
     return {};
 }
 
@@ -250,11 +258,9 @@ Result<void> measure_springs(SpringsRow& row, const CharacterCase& c, const Conv
     SceneDescription scene = case_scene(c, row.garment, ClothModel::classic, GarmentDescription{}.collision, 0, threads);
     if (!row.shear) scene.garments.at(0).parameters.push_back({"shear_N_m", 0.0});
     if (!row.bend) scene.garments.at(0).parameters.push_back({"bend_N_m", 0.0});
-    auto world = build_world(scene, {});
-    if (!world) return fail(world.error().message);
-    auto states = run_horizons(*world, c.plan, &reference.states);
-    if (!states) return fail(states.error().message);
-    row.shape_rms_m = horizon_rms_m(*states, reference.states);
+    const auto rms = shape_rms(scene, c, reference);
+    if (!rms) return fail(rms.error().message);
+    row.shape_rms_m = *rms;
     return {};
 }
 
