@@ -113,6 +113,52 @@ Real support_distance(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     return d.dot(f.center - o) + f.radii_m.cwiseProduct(f.rotation.transpose() * d).norm();
 }
 
+// Half the smallest width of an ellipsoid's level slice at height y: the slice of
+// |A (x - c)| <= 1 (A = to_unit) by the plane at y is the ellipse s^T M2 s <= 1 - t^2 k over
+// s = (x, z) about its centre, with M = A^T A, t = y - c_y, M2 its x-z block and
+// k = M_yy - m^T M2^-1 m (m = (M_xy, M_zy)); its smallest half-width is
+// sqrt((1 - t^2 k) / largest eigenvalue of M2). 0 where the plane misses the ellipsoid.
+Real slice_half_width(const EllipsoidFrame& f, Real y) {
+    const Eigen::Matrix3d a = f.to_unit.cast<double>();
+    const Eigen::Matrix3d m = a.transpose() * a;
+    Eigen::Matrix2d m2;
+    m2 << m(0, 0), m(0, 2), m(2, 0), m(2, 2);
+    const Eigen::Vector2d mixed(m(0, 1), m(2, 1));
+    const double k = m(1, 1) - mixed.dot(m2.ldlt().solve(mixed));
+    const double t = double(y) - double(f.center.y());
+    const double room = 1 - t * t * k;
+    if (!(room > 0)) return 0;
+    const double largest = (m2(0, 0) + m2(1, 1)) / 2 + std::hypot((m2(0, 0) - m2(1, 1)) / 2, m2(0, 1));
+    return largest > 0 ? static_cast<Real>(std::sqrt(room / largest)) : 0;
+}
+
+// Half the thinner leg's width at height y: per leg, the widest level slice of its
+// ellipsoids there (slice_half_width; the thigh, the knee and the shin overlap), the
+// thinner of the legs. A leg is the ellipsoids on one chain of leg bones (`leg_bone`: the
+// collider's bone on a leg, -1 off the legs), grouped by their topmost leg bone in
+// `skeleton`; without a skeleton each ellipsoid stands alone. 0 where no leg reaches y.
+Real hem_leg_half_width(std::span<const EllipsoidFrame> frames, std::span<const int> leg_bone, const SkeletonAsset* skeleton, Real y) {
+    const auto top_of = [&](int bone) {
+        if (!skeleton) return bone;
+        for (int up = bone; up >= 0 && static_cast<std::size_t>(up) < skeleton->size(); up = skeleton->parents[static_cast<std::size_t>(up)])
+            if (std::find(leg_bone.begin(), leg_bone.end(), up) != leg_bone.end()) bone = up;
+        return bone;
+    };
+    std::vector<std::pair<int, Real>> legs;  // topmost leg bone, widest slice
+    for (std::size_t e = 0; e < frames.size(); ++e) {
+        if (leg_bone[e] < 0 || !frames[e].active) continue;
+        const Real w = slice_half_width(frames[e], y);
+        if (w <= 0) continue;
+        const int top = skeleton ? top_of(leg_bone[e]) : -1 - static_cast<int>(e);
+        auto leg = std::find_if(legs.begin(), legs.end(), [&](const auto& l) { return l.first == top; });
+        if (leg == legs.end()) legs.emplace_back(top, w);
+        else leg->second = std::max(leg->second, w);
+    }
+    Real thinnest = 0;
+    for (const auto& [top, w] : legs) thinnest = thinnest == 0 ? w : std::min(thinnest, w);
+    return thinnest;
+}
+
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
                     std::span<const EllipsoidFrame> frames, std::uint32_t p, const Vec3& x) {
@@ -249,11 +295,13 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     std::vector<EllipsoidFrame> frames;
     bool placed = false;
     std::vector<std::uint8_t> limb;  // arms, hands, head: never part of the body's outline
+    std::vector<int> leg_bone;       // per collider: its bone on a leg, else -1
     for (Entity e : colliders) {
         const auto& c = registry.get<EllipsoidCollider>(e);
         placed = placed || c.initialised;
         frames.push_back(make_ellipsoid_frame(c.world));
         limb.push_back(hangs_outside_garments(c.region));
+        leg_bone.push_back(is_leg(c.region) ? c.bone : -1);
     }
     if (!placed) return fail(p + ": the character's colliders have not been placed yet (run the collider system once)");
 
@@ -315,26 +363,6 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
         return r <= 0 ? Real(0) : r + s.ease_m;
     };
     const auto direction = [](Real theta) { return Vec3(std::sin(theta), 0, std::cos(theta)); };
-    // More lines on a wider body: at most line_spacing_m apart round the ring (perimeter
-    // sampled at ring_samples directions), a multiple of weft_stride.
-    int n = s.warp_lines;
-    if (s.line_spacing_m > 0) {
-        constexpr int ring_samples = 64;
-        Real perimeter = 0;
-        Vec3 last = origin + direction(0) * ring_radius(direction(0));
-        for (int k = 1; k <= ring_samples; ++k) {
-            const Vec3 d = direction(Real(2) * std::numbers::pi_v<Real> * Real(k) / Real(ring_samples));
-            const Vec3 at = origin + d * ring_radius(d);
-            perimeter += (at - last).norm();
-            last = at;
-        }
-        const double needed = std::ceil(double(perimeter) / s.line_spacing_m / s.weft_stride) * s.weft_stride;
-        if (!(needed <= 4096 && needed * s.particles_per_line <= max_garment_particles))
-            return fail(field(p, "line_spacing_m") + ": " + number(s.line_spacing_m) + " m round a ring of " + number(perimeter) +
-                        " m needs " + number(needed) + " lines; at most 4096 lines and " + std::to_string(max_garment_particles) +
-                        " particles in all");
-        n = std::max(n, static_cast<int>(needed));
-    }
     const int m = s.particles_per_line;
     const Real flare_rad = s.flare_deg * std::numbers::pi_v<Real> / 180;
     // The hem above the ankles: a dress made for one body must not reach into the feet (or
@@ -348,15 +376,11 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
         length = std::min(length, drop / std::cos(flare_rad));
     }
     const Real step = length / Real(m - 1);
-    Matrix3X grid(3, n * m);
-    for (int line = 0; line < n; ++line) {
-        const Real theta = Real(2) * std::numbers::pi_v<Real> * Real(line) / Real(n);
-        const Vec3 d = direction(theta);
-        const Real r = ring_radius(d);
-        if (r <= 0) return fail(p + ": the body outline at the ring height does not surround the axis");
-        // Down the cone, but never closer to the axis than the body below the ring (hips,
-        // thighs, bust) plus the ease: the rest shape must fit over the body, or the cloth
-        // would hang stretched over it. Once widened, the line keeps its width below.
+    // The line toward d (level, unit) from the ring's radius r there: `put(row, point)` for
+    // each row. Down the cone, but never closer to the axis than the body below the ring
+    // (hips, thighs, bust) plus the ease: the rest shape must fit over the body, or the cloth
+    // would hang stretched over it. Once widened, the line keeps its width below.
+    const auto place_line = [&](const Vec3& d, Real r, auto&& put) {
         Real widest = r;
         for (int row = 0; row < m; ++row) {
             const Real along = step * Real(row);
@@ -370,8 +394,60 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
                 need = std::max(need, ray_exit(f, centre, d) + s.ease_m);
             }
             widest = std::max({widest, r + along * std::sin(flare_rad), need});
-            grid.col(line * m + row) = centre + d * widest;
+            put(row, centre + d * widest);
         }
+    };
+    const std::string not_surrounded = p + ": the body outline at the ring height does not surround the axis";
+    // Perimeters of the ring and of the hem, sampled at ring_samples directions.
+    constexpr int ring_samples = 64;
+    Real ring_perimeter = 0, hem_perimeter = 0;
+    Vec3 last_ring, last_hem;
+    for (int k = 0; k <= ring_samples; ++k) {
+        const Vec3 d = direction(Real(2) * std::numbers::pi_v<Real> * Real(k % ring_samples) / Real(ring_samples));
+        const Real r = ring_radius(d);
+        if (r <= 0) return fail(not_surrounded);
+        Vec3 hem = Vec3::Zero();
+        place_line(d, r, [&](int row, const Vec3& at) { if (row == m - 1) hem = at; });
+        const Vec3 ring = origin + d * r;
+        if (k > 0) {
+            ring_perimeter += (ring - last_ring).norm();
+            hem_perimeter += (hem - last_hem).norm();
+        }
+        last_ring = ring;
+        last_hem = hem;
+    }
+    // More lines where they would stand too far apart (a multiple of weft_stride, never
+    // fewer than warp_lines): round a wider body, at most line_spacing_m apart at the ring;
+    // at the hem, layer-1 lines at most hem_spacing_leg_widths times the thinner leg's width
+    // there apart, so that a hem line cannot straddle a leg (hem_leg_width).
+    int n = s.warp_lines;
+    const auto at_least = [&](double lines, std::string_view key, const std::string& why) -> Result<void> {
+        const double needed = std::ceil(lines / s.weft_stride) * s.weft_stride;
+        if (!(needed <= 4096 && needed * s.particles_per_line <= max_garment_particles))
+            return fail(field(p, key) + ": " + why + " needs " + number(needed) + " lines; at most 4096 lines and " +
+                        std::to_string(max_garment_particles) + " particles in all");
+        n = std::max(n, static_cast<int>(needed));
+        return {};
+    };
+    if (s.line_spacing_m > 0)
+        if (auto ok = at_least(double(ring_perimeter) / s.line_spacing_m, "line_spacing_m",
+                               number(s.line_spacing_m) + " m round a ring of " + number(ring_perimeter) + " m");
+            !ok)
+            return std::unexpected(ok.error());
+    const Real hem_y = origin.y() - length * std::cos(flare_rad);
+    const Real leg_width = 2 * hem_leg_half_width(frames, leg_bone, pose ? pose->asset.get() : nullptr, hem_y);
+    if (s.hem_spacing_leg_widths > 0 && leg_width > 0)
+        if (auto ok = at_least(double(hem_perimeter) / (s.hem_spacing_leg_widths * leg_width) * s.weft_stride, "hem_spacing_leg_widths",
+                               number(s.hem_spacing_leg_widths) + " x a leg " + number(leg_width) + " m wide round a hem of " +
+                                   number(hem_perimeter) + " m");
+            !ok)
+            return std::unexpected(ok.error());
+    Matrix3X grid(3, n * m);
+    for (int line = 0; line < n; ++line) {
+        const Vec3 d = direction(Real(2) * std::numbers::pi_v<Real> * Real(line) / Real(n));
+        const Real r = ring_radius(d);
+        if (r <= 0) return fail(not_surrounded);
+        place_line(d, r, [&](int row, const Vec3& at) { grid.col(line * m + row) = at; });
     }
     auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());

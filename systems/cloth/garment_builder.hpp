@@ -50,6 +50,7 @@ struct TubeParams {
     int particles_per_line = 31;      ///< Particles down each line (m). 27 x 31 = 837.
     int weft_stride = 3;              ///< Every weft_stride-th line is layer 1 (method §3.2).
     Real line_spacing_m = Real(0.029); ///< > 0: more lines on a wider body, at most this far apart round the ring (never fewer than warp_lines); 0: warp_lines.
+    Real hem_spacing_leg_widths = 2;  ///< > 0: more lines where the hem's layer-1 lines would stand farther apart than this x the thinner leg's width at the hem's height; 0: no limit.
     Real length_m = Real(0.55);       ///< Along the cone from the ring to the hem.
     Real hem_clearance_fraction = Real(0.09);  ///< The hem stays at least this x body height above the body's lowest point (the ankles): on a shorter body the garment is shortened (0: no limit).
     Real flare_deg = Real(18);        ///< Cone half-angle from vertical.

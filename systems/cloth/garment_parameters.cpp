@@ -118,6 +118,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
                 "every n-th line is integrated, the lines between are placed (method §3.2); less than `warp_lines`"),
         real("line_spacing_m", &TubeParams::line_spacing_m, closed(0, 1), "m",
              "> 0: on a wider body more lines, at most this far apart round the ring (never fewer than `warp_lines`); 0: `warp_lines` as given"),
+        real("hem_spacing_leg_widths", &TubeParams::hem_spacing_leg_widths, closed(0, 100), "",
+             "> 0: more lines where neighbouring layer-1 lines at the hem would stand farther apart than this x the thinner leg's width at the hem's height (never fewer than `warp_lines`); 0: no limit"),
         real("length_m", &TubeParams::length_m, open_min(0, 10), "m", "from the ring to the hem, along the cloth"),
         real("hem_clearance_fraction", &TubeParams::hem_clearance_fraction, open_max(0, 1), "",
              "the hem stays at least this x body height above the body's lowest point: `length_m` is shortened on a shorter body (0: never)"),
