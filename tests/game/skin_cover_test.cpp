@@ -48,14 +48,6 @@ Real outside_garment_body(Registry& registry, const Garment& g, const Vec3& x) {
     return nearest;
 }
 
-// Whether `x` lies at least as deep in a firm ellipsoid of `g` as the system draws a pulled
-// vertex (skin_cover_inset of its unit-sphere radius); such skin is left alone.
-bool deep_in_garment_body(Registry& registry, const Garment& g, const Vec3& x) {
-    for (const EllipsoidFrame& f : firm_frames(registry, g))
-        if ((f.to_unit * (x - f.center)).norm() <= 1 - skin_cover_inset) return true;
-    return false;
-}
-
 // Whether the ellipsoid of `g` nearest to `x` outside them all, or the first that holds
 // it, is one that gives (a forearm's or a hand's).
 bool nearest_gives(Registry& registry, const Garment& g, const Vec3& x) {
@@ -78,15 +70,78 @@ bool nearest_gives(Registry& registry, const Garment& g, const Vec3& x) {
 struct CoverFigures {
     std::size_t covered = 0;      ///< Vertices the garment covers.
     std::size_t stood_out = 0;    ///< Covered and outside the garment's body within reach, before the cover.
-    std::size_t shallow = 0;      ///< Covered and inside it, less deep than a pulled vertex is drawn.
-    std::size_t by_give = 0;      ///< Pulled, and nearest to (or inside) an ellipsoid that gives before the cover.
+    std::size_t by_give = 0;      ///< Of those, nearest to (or inside) an ellipsoid that gives before the cover.
     Real deepest_before_m = 0;    ///< The farthest of those.
+    std::size_t points = 0;       ///< Points of covered skin faces tested against the garment (drawn_inside).
+    std::size_t points_outside = 0;  ///< Those drawn outside the garment: skin showing through the cloth.
 };
 
+// Whether the ray o + t d (t > 0) crosses the triangle a b c (Moller-Trumbore).
+bool crosses(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 e1 = b - a, e2 = c - a, p = d.cross(e2);
+    const Real det = e1.dot(p);
+    if (std::abs(det) < Real(1e-12)) return false;
+    const Vec3 s = o - a, q = s.cross(e1);
+    const Real u = s.dot(p) / det, v = d.dot(q) / det;
+    return u >= 0 && v >= 0 && u + v <= 1 && e2.dot(q) / det > 0;
+}
+
+// Covered skin as drawn, tested against the garment as drawn: points spread over every
+// face of the skin whose three vertices are covered (corners, edges, inside), between the
+// highest point of the hem and the lowest pin (2-5 cm margins: below the hem a swinging leg
+// may stand out of the garment), each inside the garment's tube when a level ray from the
+// body's axis through it, going on outward, crosses the cloth's triangles an odd number of
+// times. Adds to `figures`.
+void check_drawn_inside(World& world, const Garment& g, const SkinCover& cover, const SkinnedMesh& skin, CoverFigures& figures) {
+    const Fabric& fabric = *g.fabric;
+    const Matrix3X& x = g.state.x;
+    const std::uint32_t m = fabric.particles_per_line;
+    Real hem_top = -std::numeric_limits<Real>::infinity(), pins_low = std::numeric_limits<Real>::infinity();
+    for (std::uint32_t line = 0; line < fabric.warp_lines; ++line) hem_top = std::max(hem_top, x(1, fabric.grid[line * m + m - 1]));
+    for (const PinBinding& pin : g.state.pins) pins_low = std::min(pins_low, x(1, static_cast<Eigen::Index>(pin.particle)));
+    const Vec3 axis = make_ellipsoid_frame(world.registry.get<EllipsoidCollider>(g.body.colliders.at(static_cast<std::size_t>(g.body.anchor))).world).center;
+    // The cloth's triangles by height, 1 cm bands: a level ray meets only those of its band.
+    constexpr Real band_m = Real(0.01);
+    const Real y0 = x.row(1).minCoeff();
+    std::vector<std::vector<std::uint32_t>> bands(static_cast<std::size_t>((x.row(1).maxCoeff() - y0) / band_m) + 1);
+    for (std::size_t t = 0; t + 2 < fabric.triangles.size(); t += 3) {
+        Real lo = std::numeric_limits<Real>::infinity(), hi = -lo;
+        for (std::size_t k = 0; k < 3; ++k) {
+            lo = std::min(lo, x(1, fabric.triangles[t + k]));
+            hi = std::max(hi, x(1, fabric.triangles[t + k]));
+        }
+        for (auto b = static_cast<std::size_t>((lo - y0) / band_m); b <= static_cast<std::size_t>((hi - y0) / band_m) && b < bands.size(); ++b)
+            bands[b].push_back(static_cast<std::uint32_t>(t));
+    }
+    std::vector<bool> covered(static_cast<std::size_t>(skin.positions.cols()), false);
+    for (const std::uint32_t v : cover.vertices) covered.at(v) = true;
+    const std::vector<std::uint32_t>& index = skin.mesh->indices;
+    constexpr int steps = 3;  // points on a face: barycentric (i, j, k) / steps
+    for (std::size_t f = 0; f + 2 < index.size(); f += 3) {
+        if (!covered[index[f]] || !covered[index[f + 1]] || !covered[index[f + 2]]) continue;
+        const Vec3 a = skin.positions.col(index[f]), b = skin.positions.col(index[f + 1]), c = skin.positions.col(index[f + 2]);
+        for (int i = 0; i <= steps; ++i)
+            for (int j = 0; i + j <= steps; ++j) {
+                const Vec3 p = a + (b - a) * (Real(i) / steps) + (c - a) * (Real(j) / steps);
+                if (p.y() < hem_top + Real(0.05) || p.y() > pins_low - Real(0.02)) continue;
+                Vec3 out(p.x() - axis.x(), 0, p.z() - axis.z());
+                if (out.norm() < Real(1e-4)) continue;
+                out.normalize();
+                const auto band = static_cast<std::size_t>((p.y() - y0) / band_m);
+                if (band >= bands.size()) continue;
+                int crossings = 0;
+                for (const std::uint32_t t : bands[band])
+                    if (crosses(p, out, x.col(fabric.triangles[t]), x.col(fabric.triangles[t + 1]), x.col(fabric.triangles[t + 2]))) ++crossings;
+                ++figures.points;
+                if (crossings % 2 == 0) ++figures.points_outside;
+            }
+    }
+}
+
 // Skins `world`'s character where it is now, runs the cover, and checks every vertex: a
-// covered one within reach outside the garment's body, or inside it less deep than
-// skin_cover_inset, ends inside it; every other one (uncovered, deep enough inside, or
-// farther out) is drawn where skinning put it. Adds to `figures`.
+// covered one within reach outside the garment's body ends inside it; an uncovered one, or
+// a covered one farther out, is drawn where skinning put it. Then the skin as drawn against
+// the garment (check_drawn_inside). Adds to `figures`.
 void check_cover_now(World& world, CoverFigures& figures) {
     skin_characters(world.registry);
     SkinnedMesh& skin = world.registry.get<SkinnedMesh>(world.characters.at(0));
@@ -99,20 +154,22 @@ void check_cover_now(World& world, CoverFigures& figures) {
     std::vector<bool> covered(static_cast<std::size_t>(skinned.cols()), false);
     for (std::uint32_t v : cover->vertices) covered.at(v) = true;
     figures.covered = cover->vertices.size();
+    std::size_t stood_out = 0;
     for (Eigen::Index v = 0; v < skinned.cols(); ++v) {
         const Real before = outside_garment_body(world.registry, g, skinned.col(v));
-        if (!covered[static_cast<std::size_t>(v)] || deep_in_garment_body(world.registry, g, skinned.col(v)) ||
-            before > skin_cover_reach_m) {
+        if (!covered[static_cast<std::size_t>(v)] || before > skin_cover_reach_m) {
             EXPECT_TRUE(skin.positions.col(v) == skinned.col(v)) << "vertex " << v << " moved";
             continue;
         }
-        ++(before == 0 ? figures.shallow : figures.stood_out);
+        EXPECT_EQ(outside_garment_body(world.registry, g, skin.positions.col(v)), 0) << "vertex " << v;
+        if (before == 0) continue;
+        ++stood_out;
         if (nearest_gives(world.registry, g, skinned.col(v))) ++figures.by_give;
         figures.deepest_before_m = std::max(figures.deepest_before_m, before);
-        EXPECT_EQ(outside_garment_body(world.registry, g, skin.positions.col(v)), 0) << "vertex " << v;
-        EXPECT_LT((skin.positions.col(v) - skinned.col(v)).norm(), before + Real(0.02)) << "vertex " << v;
     }
-    EXPECT_EQ(cover->pulled, figures.stood_out + figures.shallow);
+    figures.stood_out += stood_out;
+    EXPECT_GE(cover->pulled, stood_out);  // counted over all frames
+    check_drawn_inside(world, g, *cover, skin, figures);
     // Hands, arms and the head are never covered: the hands hang beside a skirt.
     world.registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
         if (c.region != BodyRegion::hand && c.region != BodyRegion::head) return;
@@ -140,50 +197,83 @@ CoverFigures check_cover(const SceneDescription& scene, std::initializer_list<in
     return figures;
 }
 
+// Covered skin drawn outside the garment (check_drawn_inside) is at most `share` of the
+// points tested, and some were.
+void expect_drawn_inside(const CoverFigures& f, double share) {
+    EXPECT_GT(f.points, 1000u);
+    EXPECT_LE(double(f.points_outside), share * double(f.points)) << f.points_outside << " of " << f.points << " points outside";
+}
+
+// Checks through a walk cycle, every quarter of a second.
+constexpr std::initializer_list<int> walk_cycle = {30, 45, 60, 75, 90, 105, 120};
+
+// At most this share of the covered skin's points drawn outside the garment on the shared
+// characters (slits of skin through the cloth where a face stands out by a few
+// millimetres). Measured through walk_cycle: Male_Casual's skirt 1 point of 10,156 and
+// dress 2 of 17,778, Female_Alternative's skirt and dress none of 10,008 and 18,378. With
+// skin drawn 5 % of the way in, in thin pieces too, and faces not pulled in: 11.6 %, 2.4 %,
+// 1.3 % and 0.51 %.
+constexpr double shared_share_outside = 0.002;
+
 TEST(SkinCover, TheSampleSkirtCoversTheHipsAndThighs) {
-    const CoverFigures f = check_cover(sample_scene(), {30});
+    const CoverFigures f = check_cover(sample_scene(), walk_cycle);
     EXPECT_GT(f.covered, 500u);
-    EXPECT_GT(f.shallow, 0u);  // the legs' tight ellipsoids lie just under the skin
+    EXPECT_EQ(f.points_outside, 0u) << "of " << f.points;
+    expect_drawn_inside(f, 0);
     RecordProperty("covered", std::to_string(f.covered));
     RecordProperty("stood_out", std::to_string(f.stood_out));
 }
 
 // Male_Casual's shirt hangs over his hips, up to a few centimetres outside the ellipsoids
-// the skirt lies on: without the cover it shows through the skirt below the waistband.
+// the skirt lies on: without the cover it shows through the skirt below the waistband. His
+// waist also has thin pieces (1 cm): the cloth's triangles cut through them, so skin is
+// drawn in them only where no thicker one is near (skin_cover_min_radius_m).
 TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/male_casual/Male_Casual.fbx";
     DRAPE_REQUIRE_SHARED(file);
     for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+        SCOPED_TRACE(type == GarmentType::skirt ? "skirt" : "dress");
         SceneDescription scene;
         scene.characters.emplace_back();
         scene.characters[0].file = file;
         scene.garments.emplace_back();
         scene.garments[0].type = type;
-        const CoverFigures f = check_cover(scene, {30});
+        const CoverFigures f = check_cover(scene, walk_cycle);
         EXPECT_GT(f.stood_out, 50u);
         EXPECT_GT(f.deepest_before_m, Real(0.01));
-        RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_stood_out_before",
-                       std::to_string(f.stood_out) + " vertices, up to " + std::to_string(f.deepest_before_m) + " m");
+        expect_drawn_inside(f, shared_share_outside);
+        RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_outside",
+                       std::to_string(f.points_outside) + " of " + std::to_string(f.points) + " points");
     }
 }
 
 // Female_Alternative's hands hang against her hips: hip skin by a hand lies nearer the
 // forearm's or the hand's ellipsoid than any other, and drawn just inside that one, where
 // cloth may lie too (within the give), it showed through her dress. It is drawn inside the
-// ellipsoids that do not give (check_cover: inside a firm one after the cover). Checked
-// through a walk cycle: which vertices lie by a hand depends on the fitted ellipsoids,
-// whose fit rounds differently in another build.
+// ellipsoids that do not give (check_cover_now: inside a firm one after the cover). Her hip
+// has a piece 1 cm thin that the hand presses the cloth against, whose triangles then cut
+// up to 9.5 mm into it; and her body's faces, 10-15 cm across, bridged creases the cloth
+// follows in: thin dark slits of her trousers showed through the dress. Checked through a
+// walk cycle: which vertices lie by a hand depends on the fitted ellipsoids, whose fit
+// rounds differently in another build.
 TEST(SkinCover, HipSkinByAHandStaysUnderTheDress) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/female_alternative/Female_Alternative.fbx";
     DRAPE_REQUIRE_SHARED(file);
-    SceneDescription scene;
-    scene.characters.emplace_back();
-    scene.characters[0].file = file;
-    scene.garments.emplace_back();
-    scene.garments[0].type = GarmentType::dress;
-    const CoverFigures f = check_cover(scene, {30, 45, 60, 75, 90, 105, 120});
-    EXPECT_GT(f.by_give, 0u);
-    RecordProperty("by_give", std::to_string(f.by_give));
+    for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
+        SCOPED_TRACE(type == GarmentType::skirt ? "skirt" : "dress");
+        SceneDescription scene;
+        scene.characters.emplace_back();
+        scene.characters[0].file = file;
+        scene.garments.emplace_back();
+        scene.garments[0].type = type;
+        const CoverFigures f = check_cover(scene, walk_cycle);
+        if (type == GarmentType::dress) {
+            EXPECT_GT(f.by_give, 0u);
+        }
+        expect_drawn_inside(f, shared_share_outside);
+        RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_outside",
+                       std::to_string(f.points_outside) + " of " + std::to_string(f.points) + " points");
+    }
 }
 
 }  // namespace
