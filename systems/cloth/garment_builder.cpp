@@ -113,49 +113,31 @@ Real support_distance(const EllipsoidFrame& f, const Vec3& o, const Vec3& d) {
     return d.dot(f.center - o) + f.radii_m.cwiseProduct(f.rotation.transpose() * d).norm();
 }
 
-// Half the smallest width of an ellipsoid's level slice at height y: the slice of
-// |A (x - c)| <= 1 (A = to_unit) by the plane at y is the ellipse s^T M2 s <= 1 - t^2 k over
-// s = (x, z) about its centre, with M = A^T A, t = y - c_y, M2 its x-z block and
-// k = M_yy - m^T M2^-1 m (m = (M_xy, M_zy)); its smallest half-width is
-// sqrt((1 - t^2 k) / largest eigenvalue of M2). 0 where the plane misses the ellipsoid.
-Real slice_half_width(const EllipsoidFrame& f, Real y) {
-    const Eigen::Matrix3d a = f.to_unit.cast<double>();
-    const Eigen::Matrix3d m = a.transpose() * a;
-    Eigen::Matrix2d m2;
-    m2 << m(0, 0), m(0, 2), m(2, 0), m(2, 2);
-    const Eigen::Vector2d mixed(m(0, 1), m(2, 1));
-    const double k = m(1, 1) - mixed.dot(m2.ldlt().solve(mixed));
-    const double t = double(y) - double(f.center.y());
-    const double room = 1 - t * t * k;
-    if (!(room > 0)) return 0;
-    const double largest = (m2(0, 0) + m2(1, 1)) / 2 + std::hypot((m2(0, 0) - m2(1, 1)) / 2, m2(0, 1));
-    return largest > 0 ? static_cast<Real>(std::sqrt(room / largest)) : 0;
-}
-
-// Half the thinner leg's width at height y: per leg, the widest level slice of its
-// ellipsoids there (slice_half_width; the thigh, the knee and the shin overlap), the
-// thinner of the legs. A leg is the ellipsoids on one chain of leg bones (`leg_bone`: the
-// collider's bone on a leg, -1 off the legs), grouped by their topmost leg bone in
-// `skeleton`; without a skeleton each ellipsoid stands alone. 0 where no leg reaches y.
+// Half the thinner leg's thickness at height y: per leg, the thickest of its ellipsoids
+// that the level plane at y crosses (its smallest radius; the thigh, the knee and the shin
+// overlap there), the thinner of the legs. Radii, not the slices' widths: near an
+// ellipsoid's tip (a lifted foot, a bent knee) a slice is as thin as it likes. A leg is the
+// ellipsoids on one chain of leg bones (`leg_bone`: the collider's bone on a leg, -1 off
+// the legs), grouped by their topmost leg bone in `skeleton`; without a skeleton each
+// ellipsoid stands alone. 0 where no leg reaches y.
 Real hem_leg_half_width(std::span<const EllipsoidFrame> frames, std::span<const int> leg_bone, const SkeletonAsset* skeleton, Real y) {
     const auto top_of = [&](int bone) {
-        if (!skeleton) return bone;
         for (int up = bone; up >= 0 && static_cast<std::size_t>(up) < skeleton->size(); up = skeleton->parents[static_cast<std::size_t>(up)])
             if (std::find(leg_bone.begin(), leg_bone.end(), up) != leg_bone.end()) bone = up;
         return bone;
     };
-    std::vector<std::pair<int, Real>> legs;  // topmost leg bone, widest slice
+    std::vector<std::pair<int, Real>> legs;  // topmost leg bone, thickest piece's smallest radius
     for (std::size_t e = 0; e < frames.size(); ++e) {
-        if (leg_bone[e] < 0 || !frames[e].active) continue;
-        const Real w = slice_half_width(frames[e], y);
-        if (w <= 0) continue;
+        const EllipsoidFrame& f = frames[e];
+        if (leg_bone[e] < 0 || !f.active || std::abs(f.center.y() - y) >= half_height(f)) continue;
+        const Real r = f.radii_m.minCoeff();
         const int top = skeleton ? top_of(leg_bone[e]) : -1 - static_cast<int>(e);
         auto leg = std::find_if(legs.begin(), legs.end(), [&](const auto& l) { return l.first == top; });
-        if (leg == legs.end()) legs.emplace_back(top, w);
-        else leg->second = std::max(leg->second, w);
+        if (leg == legs.end()) legs.emplace_back(top, r);
+        else leg->second = std::max(leg->second, r);
     }
     Real thinnest = 0;
-    for (const auto& [top, w] : legs) thinnest = thinnest == 0 ? w : std::min(thinnest, w);
+    for (const auto& [top, r] : legs) thinnest = thinnest == 0 ? r : std::min(thinnest, r);
     return thinnest;
 }
 
