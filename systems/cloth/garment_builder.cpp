@@ -401,7 +401,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     // More lines where they would stand too far apart (a multiple of weft_stride, never
     // fewer than warp_lines): round a wider body, at most line_spacing_m apart at the ring;
     // at the hem, layer-1 lines at most hem_spacing_leg_widths times the thinner leg's width
-    // there apart, so that a hem line cannot straddle a leg (hem_leg_width).
+    // there apart, so that a hem line cannot straddle a leg (hem_leg_half_width).
     int n = s.warp_lines;
     const auto at_least = [&](double lines, std::string_view key, const std::string& why) -> Result<void> {
         const double needed = std::ceil(lines / s.weft_stride) * s.weft_stride;
