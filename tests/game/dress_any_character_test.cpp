@@ -76,6 +76,18 @@ Inside particles_inside(World& world, const Garment& g) {
     return r;
 }
 
+// `file`'s character walking in place from `start_s` into its clip, in one garment.
+SceneDescription walking_in_place(const fs::path& file, GarmentType type, double start_s = 0) {
+    SceneDescription scene;
+    scene.characters.emplace_back();
+    scene.characters[0].file = file;
+    scene.characters[0].in_place = true;
+    scene.characters[0].start_s = start_s;
+    scene.garments.emplace_back();
+    scene.garments[0].type = type;
+    return scene;
+}
+
 void dress_and_walk(const Character& c, GarmentType type) {
     const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
     DRAPE_REQUIRE_SHARED(file);
@@ -140,13 +152,7 @@ TEST(DressAnyCharacter, GarmentsHoldTheContractOnTheSharedHumanoids) {
         const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
         DRAPE_REQUIRE_SHARED(file);
         SCOPED_TRACE(std::string(c.file) + (type == GarmentType::skirt ? ", skirt" : ", dress"));
-        SceneDescription scene;
-        scene.characters.emplace_back();
-        scene.characters[0].file = file;
-        scene.characters[0].in_place = true;
-        scene.garments.emplace_back();
-        scene.garments[0].type = type;
-        auto world = build_world(scene, {});
+        auto world = build_world(walking_in_place(file, type), {});
         ASSERT_TRUE(world) << world.error().message;
         for (int frame = 0; frame < 300; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
         const GarmentStats g = run_stats(*world).garments.at(0);
@@ -170,14 +176,7 @@ TEST(DressAnyCharacter, LinesDoNotDependOnWhereInTheWalkTheGarmentIsPutOn) {
         for (const double start_s : {0.0, 0.25, 0.375, 0.625}) {
             SCOPED_TRACE(std::string(c.file) + (type == GarmentType::skirt ? ", skirt" : ", dress") + " from " +
                          std::to_string(start_s) + " s");
-            SceneDescription scene;
-            scene.characters.emplace_back();
-            scene.characters[0].file = file;
-            scene.characters[0].in_place = true;
-            scene.characters[0].start_s = start_s;
-            scene.garments.emplace_back();
-            scene.garments[0].type = type;
-            auto world = build_world(scene, {});
+            auto world = build_world(walking_in_place(file, type, start_s), {});
             ASSERT_TRUE(world) << world.error().message;
             const std::uint32_t lines = world->registry.get<Garment>(world->garments.at(0)).fabric->warp_lines;
             if (start_s == 0) first = lines;
@@ -195,14 +194,7 @@ TEST(DressAnyCharacter, ADressStartedMidStrideHangsUnderTheArms) {
     DRAPE_REQUIRE_SHARED(file);
     for (const double start_s : {0.25, 0.625}) {
         SCOPED_TRACE("start " + std::to_string(start_s) + " s");
-        SceneDescription scene;
-        scene.characters.emplace_back();
-        scene.characters[0].file = file;
-        scene.characters[0].in_place = true;
-        scene.characters[0].start_s = start_s;
-        scene.garments.emplace_back();
-        scene.garments[0].type = GarmentType::dress;
-        auto world = build_world(scene, {});
+        auto world = build_world(walking_in_place(file, GarmentType::dress, start_s), {});
         ASSERT_TRUE(world) << world.error().message;
         for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
         test::expect_character_contract(run_stats(*world).garments.at(0));

@@ -215,6 +215,16 @@ constexpr std::initializer_list<int> walk_cycle = {30, 45, 60, 75, 90, 105, 120}
 // 1.3 % and 0.51 %.
 constexpr double shared_share_outside = 0.002;
 
+// `file`'s character walking, in one garment.
+SceneDescription walking(const fs::path& file, GarmentType type) {
+    SceneDescription scene;
+    scene.characters.emplace_back();
+    scene.characters[0].file = file;
+    scene.garments.emplace_back();
+    scene.garments[0].type = type;
+    return scene;
+}
+
 TEST(SkinCover, TheSampleSkirtCoversTheHipsAndThighs) {
     const CoverFigures f = check_cover(sample_scene(), walk_cycle);
     EXPECT_GT(f.covered, 500u);
@@ -233,12 +243,7 @@ TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
     DRAPE_REQUIRE_SHARED(file);
     for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
         SCOPED_TRACE(type == GarmentType::skirt ? "skirt" : "dress");
-        SceneDescription scene;
-        scene.characters.emplace_back();
-        scene.characters[0].file = file;
-        scene.garments.emplace_back();
-        scene.garments[0].type = type;
-        const CoverFigures f = check_cover(scene, walk_cycle);
+        const CoverFigures f = check_cover(walking(file, type), walk_cycle);
         EXPECT_GT(f.stood_out, 50u);
         EXPECT_GT(f.deepest_before_m, Real(0.01));
         expect_drawn_inside(f, shared_share_outside);
@@ -261,12 +266,7 @@ TEST(SkinCover, HipSkinByAHandStaysUnderTheDress) {
     DRAPE_REQUIRE_SHARED(file);
     for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
         SCOPED_TRACE(type == GarmentType::skirt ? "skirt" : "dress");
-        SceneDescription scene;
-        scene.characters.emplace_back();
-        scene.characters[0].file = file;
-        scene.garments.emplace_back();
-        scene.garments[0].type = type;
-        const CoverFigures f = check_cover(scene, walk_cycle);
+        const CoverFigures f = check_cover(walking(file, type), walk_cycle);
         if (type == GarmentType::dress) {
             EXPECT_GT(f.by_give, 0u);
         }
