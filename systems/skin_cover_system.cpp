@@ -176,7 +176,10 @@ std::uint64_t pull_in(std::span<const EllipsoidFrame> frames, std::span<const Ho
 // holder each lies deepest in as they are drawn in it, at most face_rounds times. A face
 // whose three vertices lie in one holder lies in it whole (an ellipsoid is convex) and is
 // not looked at: `inside`, per vertex, the bit of a holder that holds it (pull_in's).
-// Returns the pulls.
+// A vertex held by a thin piece only goes toward that piece's centre: skin there lies under
+// the cloth, and with thick holders only, Female_Alternative's skirt in the sanitizer
+// build, whose fit leaves her right hip to a piece 1 cm thin, drew 65 of 9,932 tested
+// points outside the garment instead of 56. Returns the pulls.
 std::uint64_t pull_faces_in(std::span<const EllipsoidFrame> frames, std::span<const Holder> holders, const MeshAsset& mesh,
                             const SkinCover& cover, SkinnedMesh& skin, CoverScratch& scratch) {
     constexpr int face_rounds = 4;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <initializer_list>
 #include <string>
@@ -74,6 +75,7 @@ struct CoverFigures {
     Real deepest_before_m = 0;    ///< The farthest of those.
     std::size_t points = 0;       ///< Points of covered skin faces tested against the garment (drawn_inside).
     std::size_t points_outside = 0;  ///< Those drawn outside the garment: skin showing through the cloth.
+    std::uint64_t pulled_for_faces = 0;  ///< SkinCover::pulled_for_faces at the last check.
 };
 
 // Whether the ray o + t d (t > 0) crosses the triangle a b c (Moller-Trumbore).
@@ -169,6 +171,7 @@ void check_cover_now(World& world, CoverFigures& figures) {
     }
     figures.stood_out += stood_out;
     EXPECT_GE(cover->pulled, stood_out);  // counted over all frames
+    figures.pulled_for_faces = cover->pulled_for_faces;
     check_drawn_inside(world, g, *cover, skin, figures);
     // Hands, arms and the head are never covered: the hands hang beside a skirt.
     world.registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
@@ -251,9 +254,12 @@ TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
         const CoverFigures f = check_cover(walking(file, type), walk_cycle);
         EXPECT_GT(f.stood_out, 50u);
         EXPECT_GT(f.deepest_before_m, Real(0.01));
+        EXPECT_GT(f.pulled_for_faces, 0u);  // his faces bridge creases: the face pass has work
         expect_drawn_inside(f, shared_share_outside);
         RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_outside",
                        std::to_string(f.points_outside) + " of " + std::to_string(f.points) + " points");
+        RecordProperty(std::string(type == GarmentType::skirt ? "skirt" : "dress") + "_pulled_for_faces",
+                       std::to_string(f.pulled_for_faces));
     }
 }
 
