@@ -104,7 +104,8 @@ struct GarmentSolver {
     Vec3 anchor_velocity_before = Vec3::Zero();      ///< The anchor's V when the velocities were last written.
     Vec3 anchor_angular_before = Vec3::Zero();       ///< Its W then.
     bool anchor_known = false;               ///< False: no step yet (the anchor's motion so far counts as none).
-    bool settling = false;                   ///< In the first fixed step after the build or a reset (contact repair's larger round budget).
+    double settled_s = 0;                    ///< Simulated time since the build or the last reset.
+    bool settling = false;                   ///< In the first 1/6 s after the build or a reset (contact repair's larger round budget).
 
     // Scratch (no allocation per step once sized).
     Matrix3X x_start;                        ///< Positions at the start of the substep.

@@ -30,13 +30,16 @@ constexpr Real limit_share = Real(0.5);
 constexpr Real leader_damping = Real(0.9);
 
 // Contact repair (repair_pushes): at most this many rounds per substep, and the share of its
-// inverse mass a pushed particle keeps in them. In the first fixed step after the garment is
-// built or reset the budget is larger: the garment starts from its rest shape round a body
-// already in the clip's first pose, a hem across a bent knee (RobotExpressive's dress: 57 %
-// after the first frame at 48 rounds, 10.0 % at 96). Later in a walk more rounds do not help
-// (Female_Alternative's skirt: 107 % at 48, 407 % at 96).
+// inverse mass a pushed particle keeps in them. For settling_s after the garment is built or
+// reset the budget is larger: the garment starts from its rest shape round a body already in
+// the clip's pose of the moment, a hem across a bent knee, and falls onto the body (Robot-
+// Expressive's dress: 57 % after the first frame at 48 rounds, 10.0 % at 96; put on 0.375 s
+// into its walk, 70.2 % in its seventh frame with the larger budget in the first step only,
+// 10.0 % with it for 1/6 s). Later in a walk more rounds do not help (Female_Alternative's
+// skirt: 107 % at 48, 407 % at 96).
 constexpr int repair_rounds = 48;
 constexpr int settling_repair_rounds = 192;
+constexpr double settling_s = 1.0 / 6.0;
 constexpr Real pushed_weight = Real(0.1);
 
 // The weft limit's work in a row, for sharing the rows out between parts: a spring it
@@ -106,7 +109,11 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
     });
     // Then the layer-2 particles whose chord crosses a band edge, both ends now predicted.
     if (carry) carry_weft(*g.fabric, s.parts.edge_weft_entries, state.inv_mass, s.x_start, state.x);
-    if (sub.index == 0) s.settling = !s.anchor_known;
+    if (sub.index == 0) {
+        if (!s.anchor_known) s.settled_s = 0;
+        s.settling = s.settled_s < settling_s * (1 - 1e-9);  // the steps of the first settling_s, rounding aside
+        s.settled_s += sub.fixed_dt_s;
+    }
     s.anchor_velocity_before = motion.velocity_m_s;
     s.anchor_angular_before = motion.angular_velocity_rad_s;
     s.anchor_known = true;
@@ -407,7 +414,7 @@ void merge_sorted(std::vector<std::uint32_t>& out, const std::vector<PartScratch
 // limited again, a particle pushed in this substep taken as heavier (inverse mass x
 // pushed_weight) so that the limits move its neighbours toward it rather than it back into
 // the body; then what they moved is collided again. Until no spring of a moved particle is
-// over the limit, or repair_rounds rounds (settling_repair_rounds in the first step).
+// over the limit, or repair_rounds rounds (settling_repair_rounds while settling).
 // Each stage of a round runs in parts at the same time, on particles no other part touches:
 // the check of the moved particles, the warp limit on a share of the listed lines, the weft
 // limit on a share of the listed rows, the collision of what they moved by line (line number
