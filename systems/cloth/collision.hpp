@@ -39,7 +39,9 @@
 //      over its skin) leaves a particle inside it where it lies no deeper than its give less
 //      the particle's distance outside the nearest ellipsoid that does not give (a lower
 //      bound, the list clearance below); a particle deeper goes along the centre line to
-//      that depth. Cloth caught between a forearm and the hips keeps to the hips.
+//      that depth. Cloth caught between a forearm and the hips keeps to the hips. A particle
+//      left within a give is in contact all the same: its approach to that ellipsoid is
+//      removed and friction applied, as at any contact (a soft surface).
 //      Within a substep, a particle that collided takes the velocity of its whole move,
 //      (x_end - x_start) / h, before the normal component is removed: the constraints
 //      and the push-out then cannot pump energy into a particle held against the body.
