@@ -139,7 +139,7 @@ void dress_and_walk(const Character& c, GarmentType type) {
 // sanitizer build too (137 % there before the forearms and hands gave). Left out, within it
 // in the release build only and not from every start (chaotic walks; the release build is
 // made for its CPU): Female_Alternative's dress (10.6 % here, 19.2 % on the Xeon; over 20 %
-// from 3 of 8 points of its clip here; 512 % in the sanitizer build, measured before the
+// from 3 of 8 points of its clip here; 578 % in the sanitizer build, 512 % there before the
 // tuck under the arms; 172 % in the release build before the give).
 TEST(DressAnyCharacter, GarmentsHoldTheContractOnTheSharedHumanoids) {
     const Character female{"characters/female_alternative/Female_Alternative.fbx", ""};
