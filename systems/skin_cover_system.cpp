@@ -14,6 +14,7 @@
 #include "components/skin_cover.hpp"
 #include "components/skinned_mesh.hpp"
 #include "systems/cloth/body.hpp"
+#include "systems/cloth/collision.hpp"
 
 namespace drape {
 namespace {
@@ -93,9 +94,6 @@ void list_holders(std::span<const EllipsoidFrame> frames, std::vector<Holder>& h
             holders.push_back({static_cast<std::uint32_t>(e), holds_covered_skin(frames[e]), skin_cover_depth(frames[e])});
 }
 
-// Unit-sphere radius of x in frame f.
-Real unit_radius(const EllipsoidFrame& f, const Vec3& x) { return (f.to_unit * (x - f.center)).norm(); }
-
 // The holder that holds `x` deepest (the thin ones only when no thick one holds it); none
 // (nullptr) when `x` is in none.
 const Holder* deepest_holding(std::span<const EllipsoidFrame> frames, std::span<const Holder> holders, const Vec3& x) {
@@ -104,7 +102,7 @@ const Holder* deepest_holding(std::span<const EllipsoidFrame> frames, std::span<
     for (const bool thin_too : {false, true}) {
         for (const Holder& h : holders) {
             if (!thin_too && !h.thick) continue;
-            const Real y = unit_radius(frames[h.e], x);
+            const Real y = to_unit_sphere(frames[h.e], x).norm();
             if (y < best) {
                 best = y;
                 deepest = &h;
@@ -189,9 +187,9 @@ std::uint64_t pull_faces_in(std::span<const EllipsoidFrame> frames, std::span<co
     // Whether x lies outside every holder, those of `near` (the face's vertices') tried first.
     const auto outside = [&](const Vec3& x, std::uint64_t near) {
         for (std::uint64_t bits = near; bits != 0; bits &= bits - 1)
-            if (unit_radius(frames[static_cast<std::size_t>(std::countr_zero(bits))], x) <= 1) return false;
+            if (to_unit_sphere(frames[static_cast<std::size_t>(std::countr_zero(bits))], x).norm() <= 1) return false;
         for (const Holder& h : holders)
-            if ((near >> h.e & 1) == 0 && unit_radius(frames[h.e], x) <= 1) return false;
+            if ((near >> h.e & 1) == 0 && to_unit_sphere(frames[h.e], x).norm() <= 1) return false;
         return true;
     };
     std::uint64_t pulled = 0;
