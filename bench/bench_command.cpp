@@ -10,7 +10,7 @@
 #include <tbb/global_control.h>
 
 #include "bench/report.hpp"
-#include "game/commands.hpp"
+#include "drape/game/commands.hpp"
 
 namespace drape {
 

@@ -14,8 +14,8 @@
 #include <memory>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape::bench {
 

@@ -20,11 +20,11 @@
 #include "bench/reference.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
-#include "systems/cloth/garment_config.hpp"
-#include "systems/cloth/garment_quality.hpp"
-#include "systems/cloth_systems.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
+#include "drape/systems/cloth_systems.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape::bench {
 

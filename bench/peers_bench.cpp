@@ -30,7 +30,7 @@
 #include "bench/report.hpp"
 #include "bench/stability_bench.hpp"
 #include "bench/world.hpp"
-#include "systems/cloth/garment_quality.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 
 #include <LinearMath/btScalar.h>
 

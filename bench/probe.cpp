@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "components/ellipsoid_collider.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
 
 namespace drape::bench {
 

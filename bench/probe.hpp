@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "bench/bullet_cloth.hpp"
-#include "components/garment.hpp"
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape::bench {
 

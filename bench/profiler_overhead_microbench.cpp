@@ -2,8 +2,8 @@
 // Run: build/bench/drape_microbench --benchmark_filter=Profiler --benchmark_repetitions=5
 #include <benchmark/benchmark.h>
 
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace {
 

@@ -24,14 +24,14 @@
 #include "bench/reference.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
-#include "components/animation_player.hpp"
-#include "components/character.hpp"
-#include "components/garment.hpp"
-#include "game/asset_paths.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/character.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/game/asset_paths.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
-#include "engine/render/image.hpp"
-#include "engine/render/renderer.hpp"
+#include "drape/engine/render/image.hpp"
+#include "drape/engine/render/renderer.hpp"
 #endif
 
 namespace drape::bench {

@@ -5,8 +5,8 @@
 
 #include "bench/probe.hpp"
 #include "bench/report.hpp"
-#include "components/garment.hpp"
-#include "systems/cloth/garment_config.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/systems/cloth/garment_config.hpp"
 
 namespace drape::bench {
 

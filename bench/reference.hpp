@@ -26,9 +26,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
-#include "game/world.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/game/world.hpp"
 
 namespace drape::bench {
 

@@ -13,8 +13,8 @@
 #include "bench/report.hpp"
 #include "bench/world.hpp"
 #ifdef DRAPE_HAVE_RENDER
-#include "engine/render/renderer.hpp"
-#include "systems/render_system.hpp"
+#include "drape/engine/render/renderer.hpp"
+#include "drape/systems/render_system.hpp"
 #endif
 
 namespace drape::bench {

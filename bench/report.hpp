@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/core/error.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape::bench {
 

@@ -13,9 +13,9 @@
 #include "bench/probe.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "systems/cloth/garment_quality.hpp"
-#include "systems/cloth/integrator.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
+#include "drape/systems/cloth/integrator.hpp"
 
 namespace drape::bench {
 

@@ -25,13 +25,13 @@
 
 #include "bench/report.hpp"
 #include "bench/world.hpp"
-#include "components/animation_player.hpp"
-#include "components/transform.hpp"
-#include "systems/cloth/garment_config.hpp"
-#include "systems/cloth/garment_quality.hpp"
-#include "systems/cloth/garment_step.hpp"
-#include "systems/cloth/integrator.hpp"
-#include "systems/cloth/substeps.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/integrator.hpp"
+#include "drape/systems/cloth/substeps.hpp"
 
 namespace drape::bench {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "bench/probe.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape::bench {
 

@@ -23,9 +23,9 @@
 #include "bench/probe.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
-#include "components/skeleton.hpp"
-#include "systems/cloth/collision.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/systems/cloth/collision.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape::bench {
 

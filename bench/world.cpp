@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "game/asset_paths.hpp"
-#include "game/sample_scene.hpp"
+#include "drape/game/asset_paths.hpp"
+#include "drape/game/sample_scene.hpp"
 
 namespace drape::bench {
 

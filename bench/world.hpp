@@ -4,9 +4,9 @@
 
 #include <vector>
 
-#include "components/garment.hpp"
-#include "engine/core/error.hpp"
-#include "game/world.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/game/world.hpp"
 
 namespace drape::bench {
 

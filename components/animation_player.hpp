@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "engine/assets/animation_clip.hpp"
+#include "drape/engine/assets/animation_clip.hpp"
 
 namespace drape {
 

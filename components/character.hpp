@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <string>
 
-#include "engine/core/math.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

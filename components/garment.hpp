@@ -32,8 +32,8 @@
 #include <memory>
 #include <vector>
 
-#include "engine/core/math.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

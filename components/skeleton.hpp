@@ -4,8 +4,8 @@
 #include <memory>
 #include <vector>
 
-#include "engine/assets/skeleton_asset.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/assets/skeleton_asset.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "engine/assets/mesh_asset.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/assets/mesh_asset.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

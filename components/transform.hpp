@@ -1,7 +1,7 @@
 // Where an entity stands in the world.
 #pragma once
 
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

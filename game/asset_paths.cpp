@@ -1,5 +1,5 @@
 // Asset lookup; see asset_paths.hpp.
-#include "game/asset_paths.hpp"
+#include "drape/game/asset_paths.hpp"
 
 #include <cstdlib>
 #include <system_error>

@@ -19,7 +19,7 @@
 // Determinism: plain double arithmetic in a fixed order, ordered containers only, no clocks;
 // the exporter is fed one scene built the same way each time and writes to memory, so the
 // output path never leaks into the bytes.
-#include "game/avatar_generator.hpp"
+#include "drape/game/avatar_generator.hpp"
 
 #include <algorithm>
 #include <array>

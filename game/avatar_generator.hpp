@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/math.hpp"
 
 struct aiScene;
 

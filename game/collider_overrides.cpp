@@ -1,11 +1,11 @@
 // Collider overrides; see collider_overrides.hpp.
-#include "game/collider_overrides.hpp"
+#include "drape/game/collider_overrides.hpp"
 
 #include <string>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "systems/character/spawn.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/systems/character/spawn.hpp"
 
 namespace drape {
 

@@ -7,10 +7,10 @@
 #include <cstddef>
 #include <span>
 
-#include "engine/assets/character_asset.hpp"
-#include "engine/core/error.hpp"
-#include "engine/core/registry.hpp"
-#include "game/scene_description.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/game/scene_description.hpp"
 
 namespace drape {
 

@@ -18,7 +18,7 @@
 #include <vector>
 #pragma GCC diagnostic pop
 
-#include "game/command_line.hpp"
+#include "drape/game/command_line.hpp"
 
 namespace drape {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "game/command_line.hpp"
+#include "drape/game/command_line.hpp"
 
 namespace drape {
 

@@ -9,17 +9,17 @@
 #include <cstdio>
 #include <string>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "engine/assets/character_import.hpp"
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
-#include "game/asset_paths.hpp"
-#include "systems/character_systems.hpp"
-#include "systems/character/spawn.hpp"
-#include "systems/cloth_systems.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_quality.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/game/asset_paths.hpp"
+#include "drape/systems/character_systems.hpp"
+#include "drape/systems/character/spawn.hpp"
+#include "drape/systems/cloth_systems.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 
 namespace {
 

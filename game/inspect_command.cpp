@@ -5,10 +5,10 @@
 #include <optional>
 #include <string>
 
-#include "engine/assets/character_import.hpp"
-#include "game/commands.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character/character_report.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/game/commands.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/character_report.hpp"
 
 namespace drape {
 

@@ -2,7 +2,7 @@
 // Exit codes (every subcommand): 0 done, 1 bad input or a failed run (game/commands.hpp).
 #include <vector>
 
-#include "game/commands.hpp"
+#include "drape/game/commands.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"Drape: real-time physically based garments on skinned, walking characters"};

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "game/avatar_generator.hpp"
-#include "game/commands.hpp"
-#include "game/output_files.hpp"
+#include "drape/game/avatar_generator.hpp"
+#include "drape/game/commands.hpp"
+#include "drape/game/output_files.hpp"
 
 namespace drape {
 

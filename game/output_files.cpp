@@ -1,5 +1,5 @@
 // See output_files.hpp.
-#include "game/output_files.hpp"
+#include "drape/game/output_files.hpp"
 
 // GCC 12 with the sanitizers warns inside libstdc++'s <regex> (the std::function in its
 // automaton's states: -Wmaybe-uninitialized, a false positive); the standard headers are

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "engine/core/error.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape {
 

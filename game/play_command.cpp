@@ -21,16 +21,16 @@
 
 #include <unistd.h>
 
-#include "game/commands.hpp"
-#include "game/output_files.hpp"
-#include "game/sample_scene.hpp"
-#include "game/scene_file.hpp"
-#include "game/stats.hpp"
-#include "game/video.hpp"
-#include "game/world.hpp"
+#include "drape/game/commands.hpp"
+#include "drape/game/output_files.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/scene_file.hpp"
+#include "drape/game/stats.hpp"
+#include "drape/game/video.hpp"
+#include "drape/game/world.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
-#include "engine/render/renderer.hpp"
+#include "drape/engine/render/renderer.hpp"
 #endif
 
 namespace drape {

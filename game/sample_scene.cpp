@@ -1,7 +1,7 @@
 // The sample scene; see sample_scene.hpp.
-#include "game/sample_scene.hpp"
+#include "drape/game/sample_scene.hpp"
 
-#include "game/asset_paths.hpp"
+#include "drape/game/asset_paths.hpp"
 
 namespace drape {
 

@@ -2,7 +2,7 @@
 // `drape play` plays with no scene named.
 #pragma once
 
-#include "game/scene_description.hpp"
+#include "drape/game/scene_description.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Scene descriptions; see scene_description.hpp.
-#include "game/scene_description.hpp"
+#include "drape/game/scene_description.hpp"
 
 namespace drape {
 

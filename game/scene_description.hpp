@@ -14,8 +14,8 @@
 #include <string_view>
 #include <vector>
 
-#include "components/garment.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

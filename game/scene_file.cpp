@@ -6,7 +6,7 @@
 // once and records, for every field path ("garments[0].particles"), where its key and its
 // value start. The reader then walks the JSON tree field by field; an internal exception
 // carries the first error out to the boundary, where it becomes a Result.
-#include "game/scene_file.hpp"
+#include "drape/game/scene_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,8 +19,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "game/scene_garment_parameters.hpp"
-#include "systems/cloth/garment_parameters.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape {
 

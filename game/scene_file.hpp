@@ -14,9 +14,9 @@
 #include <string_view>
 #include <utility>
 
-#include "engine/core/error.hpp"
-#include "game/scene_description.hpp"
-#include "systems/cloth/garment_builder.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/game/scene_description.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Garment parameters as a scene names them; see scene_garment_parameters.hpp.
-#include "game/scene_garment_parameters.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
 
 #include <algorithm>
 #include <cmath>

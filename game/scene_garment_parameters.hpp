@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "game/scene_description.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_parameters.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/game/scene_description.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape {
 

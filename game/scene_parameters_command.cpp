@@ -4,8 +4,8 @@
 // docs/scenes.md differs from this output.
 #include <cstdio>
 
-#include "game/commands.hpp"
-#include "game/scene_garment_parameters.hpp"
+#include "drape/game/commands.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
 
 namespace drape {
 

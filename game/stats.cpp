@@ -1,11 +1,11 @@
-#include "game/stats.hpp"
+#include "drape/game/stats.hpp"
 
 #include <cmath>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
 
-#include "components/garment.hpp"
+#include "drape/components/garment.hpp"
 
 namespace drape {
 

@@ -23,10 +23,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "engine/core/profiler.hpp"
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_quality.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/profiler.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 
 namespace drape {
 

@@ -1,4 +1,4 @@
-#include "game/video.hpp"
+#include "drape/game/video.hpp"
 
 #include <csignal>
 #include <cstdlib>
@@ -6,7 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "engine/render/image.hpp"
+#include "drape/engine/render/image.hpp"
 
 namespace drape {
 

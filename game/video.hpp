@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "engine/core/error.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape {
 

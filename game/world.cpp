@@ -1,33 +1,33 @@
 // Worlds built from scene descriptions; see world.hpp.
-#include "game/world.hpp"
+#include "drape/game/world.hpp"
 
 #include <cmath>
 #include <map>
 
 #include <tbb/global_control.h>
 
-#include "components/animation_player.hpp"
-#include "components/character.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
-#include "engine/assets/character_import.hpp"
-#include "game/collider_overrides.hpp"
-#include "game/scene_file.hpp"
-#include "game/scene_garment_parameters.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character_systems.hpp"
-#include "systems/character/spawn.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_config.hpp"
-#include "systems/cloth_systems.hpp"
-#include "systems/teleport_guard_system.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/character.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/game/collider_overrides.hpp"
+#include "drape/game/scene_file.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character_systems.hpp"
+#include "drape/systems/character/spawn.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth_systems.hpp"
+#include "drape/systems/teleport_guard_system.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
-#include "engine/render/renderer.hpp"
-#include "systems/render_system.hpp"
-#include "systems/skin_cover_system.hpp"
-#include "systems/skinning_system.hpp"
+#include "drape/engine/render/renderer.hpp"
+#include "drape/systems/render_system.hpp"
+#include "drape/systems/skin_cover_system.hpp"
+#include "drape/systems/skinning_system.hpp"
 #endif
 
 namespace drape {

@@ -26,12 +26,12 @@
 #include <string>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
-#include "game/scene_description.hpp"
-#include "game/stats.hpp"
-#include "systems/teleport_guard_system.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/game/scene_description.hpp"
+#include "drape/game/stats.hpp"
+#include "drape/systems/teleport_guard_system.hpp"
 
 namespace drape {
 

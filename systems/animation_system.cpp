@@ -1,15 +1,15 @@
 // Animation system: see animation_system.hpp.
-#include "systems/animation_system.hpp"
+#include "drape/systems/animation_system.hpp"
 
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "components/animation_player.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/character/animation.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/character/animation.hpp"
 
 namespace drape {
 

@@ -6,7 +6,7 @@
 // posed in parallel.
 #pragma once
 
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
 

@@ -1,7 +1,7 @@
-#include "systems/character_systems.hpp"
+#include "drape/systems/character_systems.hpp"
 
-#include "systems/animation_system.hpp"
-#include "systems/collider_system.hpp"
+#include "drape/systems/animation_system.hpp"
+#include "drape/systems/collider_system.hpp"
 
 namespace drape {
 

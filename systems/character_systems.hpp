@@ -4,7 +4,7 @@
 // a world that renders.
 #pragma once
 
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Cloth collision system; see cloth_collision_system.hpp.
-#include "systems/cloth_collision_system.hpp"
+#include "drape/systems/cloth_collision_system.hpp"
 
 namespace drape {
 

@@ -4,9 +4,9 @@
 // the velocities; after the rounds, the non-finite check. Timed as "cloth_collision".
 #pragma once
 
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_batch.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_batch.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape {
 

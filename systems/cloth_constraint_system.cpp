@@ -1,5 +1,5 @@
 // Cloth constraint system; see cloth_constraint_system.hpp.
-#include "systems/cloth_constraint_system.hpp"
+#include "drape/systems/cloth_constraint_system.hpp"
 
 namespace drape {
 

@@ -5,8 +5,8 @@
 // model, the weft's places recorded for the next substep. Timed as "cloth_constraint".
 #pragma once
 
-#include "systems/cloth/garment_batch.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/garment_batch.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape {
 

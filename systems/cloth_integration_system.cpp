@@ -1,5 +1,5 @@
 // Cloth integration system; see cloth_integration_system.hpp.
-#include "systems/cloth_integration_system.hpp"
+#include "drape/systems/cloth_integration_system.hpp"
 
 namespace drape {
 

@@ -6,9 +6,9 @@
 // step (cloth_systems.hpp) runs it and times it as "cloth_integration".
 #pragma once
 
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_batch.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_batch.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape {
 

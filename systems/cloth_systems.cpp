@@ -1,5 +1,5 @@
 // The cloth step; see cloth_systems.hpp.
-#include "systems/cloth_systems.hpp"
+#include "drape/systems/cloth_systems.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,14 +10,14 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/cloth/garment_batch.hpp"
-#include "systems/cloth_collision_system.hpp"
-#include "systems/cloth_constraint_system.hpp"
-#include "systems/cloth_integration_system.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/cloth/garment_batch.hpp"
+#include "drape/systems/cloth_collision_system.hpp"
+#include "drape/systems/cloth_constraint_system.hpp"
+#include "drape/systems/cloth_integration_system.hpp"
 
 namespace drape {
 namespace {

@@ -16,8 +16,8 @@
 // shared out by the systems' time summed over the threads (one run per fixed step).
 #pragma once
 
-#include "engine/core/scheduler.hpp"
-#include "systems/cloth/substeps.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/systems/cloth/substeps.hpp"
 
 namespace drape {
 

@@ -1,15 +1,15 @@
 // Collider system: see collider_system.hpp.
-#include "systems/collider_system.hpp"
+#include "drape/systems/collider_system.hpp"
 
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/character/colliders.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/character/colliders.hpp"
 
 namespace drape {
 

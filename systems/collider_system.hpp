@@ -6,7 +6,7 @@
 // gives a velocity and still zero acceleration. Colliders are updated in parallel.
 #pragma once
 
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
 

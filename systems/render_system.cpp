@@ -1,16 +1,16 @@
-#include "systems/render_system.hpp"
+#include "drape/systems/render_system.hpp"
 
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "components/character.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skinned_mesh.hpp"
-#include "systems/skin_cover_system.hpp"
-#include "systems/skinning_system.hpp"
+#include "drape/components/character.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/systems/skin_cover_system.hpp"
+#include "drape/systems/skinning_system.hpp"
 
 namespace drape {
 namespace {

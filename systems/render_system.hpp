@@ -11,10 +11,10 @@
 #include <optional>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
-#include "engine/render/renderer.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/engine/render/renderer.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Skin cover system: see skin_cover_system.hpp.
-#include "systems/skin_cover_system.hpp"
+#include "drape/systems/skin_cover_system.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -8,13 +8,13 @@
 #include <span>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/skin_cover.hpp"
-#include "components/skinned_mesh.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skin_cover.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
 
 namespace drape {
 namespace {

@@ -39,10 +39,10 @@
 // sees these positions.
 #pragma once
 
-#include "engine/core/math.hpp"
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
-#include "systems/cloth/garment_solver.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
 
 namespace drape {
 

@@ -1,15 +1,15 @@
 // Skinning system: see skinning_system.hpp.
-#include "systems/skinning_system.hpp"
+#include "drape/systems/skinning_system.hpp"
 
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
-#include "components/transform.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 namespace {

@@ -9,8 +9,8 @@
 // SkinnedMesh::skinned_vertices.
 #pragma once
 
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
 

@@ -1,14 +1,14 @@
 // Teleport guard: see teleport_guard_system.hpp.
-#include "systems/teleport_guard_system.hpp"
+#include "drape/systems/teleport_guard_system.hpp"
 
 #include <utility>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/cloth/garment_builder.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
 

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
 

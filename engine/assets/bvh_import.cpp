@@ -13,8 +13,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include "engine/assets/character_import.hpp"
-#include "engine/assets/skinning.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/engine/assets/skinning.hpp"
 
 namespace drape {
 

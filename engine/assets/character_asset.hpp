@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/assets/animation_clip.hpp"
-#include "engine/assets/mesh_asset.hpp"
-#include "engine/assets/skeleton_asset.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/assets/animation_clip.hpp"
+#include "drape/engine/assets/mesh_asset.hpp"
+#include "drape/engine/assets/skeleton_asset.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

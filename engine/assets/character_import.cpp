@@ -6,7 +6,7 @@
 // limited to 4 and normalised; rigid meshes get weight 1 on the bone they hang from);
 // convert clips to seconds; correct axes, then units; measure height. Fitting ellipsoids
 // to the result is the character systems' work (systems/character/character_body.hpp).
-#include "engine/assets/character_import.hpp"
+#include "drape/engine/assets/character_import.hpp"
 
 #include <algorithm>
 #include <array>
@@ -27,7 +27,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include "engine/assets/skinning.hpp"
+#include "drape/engine/assets/skinning.hpp"
 
 namespace drape {
 

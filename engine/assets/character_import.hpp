@@ -19,8 +19,8 @@
 #include <string>
 #include <string_view>
 
-#include "engine/assets/character_asset.hpp"
-#include "engine/core/error.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Composing poses and skinning (method §1.1, §1.2). See skinning.hpp.
-#include "engine/assets/skinning.hpp"
+#include "drape/engine/assets/skinning.hpp"
 
 #include <cassert>
 

@@ -7,9 +7,9 @@
 #include <span>
 #include <vector>
 
-#include "engine/assets/mesh_asset.hpp"
-#include "engine/assets/skeleton_asset.hpp"
-#include "engine/core/math.hpp"
+#include "drape/engine/assets/mesh_asset.hpp"
+#include "drape/engine/assets/skeleton_asset.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -1,4 +1,4 @@
-#include "engine/core/profiler.hpp"
+#include "drape/engine/core/profiler.hpp"
 
 #include <algorithm>
 #include <cstdio>

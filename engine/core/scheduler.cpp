@@ -1,4 +1,4 @@
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "engine/core/error.hpp"
-#include "engine/core/profiler.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/profiler.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

@@ -1,4 +1,4 @@
-#include "engine/render/camera.hpp"
+#include "drape/engine/render/camera.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,7 @@
 
 #include <optional>
 
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

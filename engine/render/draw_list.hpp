@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

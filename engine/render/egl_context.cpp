@@ -1,4 +1,4 @@
-#include "engine/render/egl_context.hpp"
+#include "drape/engine/render/egl_context.hpp"
 
 #include <cstdio>
 #include <cstring>

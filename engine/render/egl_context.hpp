@@ -7,7 +7,7 @@
 
 #include <EGL/egl.h>
 
-#include "engine/core/error.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape::render_detail {
 

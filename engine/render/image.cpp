@@ -1,4 +1,4 @@
-#include "engine/render/image.hpp"
+#include "drape/engine/render/image.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "engine/core/error.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape {
 

@@ -10,7 +10,7 @@
 // GPU buffers are kept per DrawKey and updated with glNamedBufferSubData each frame; they
 // are created when a key first appears (or its vertex count or triangle list changes) and
 // freed when a frame no longer lists it, so a steady scene allocates nothing per frame.
-#include "engine/render/renderer.hpp"
+#include "drape/engine/render/renderer.hpp"
 
 #include <algorithm>
 #include <array>
@@ -23,10 +23,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "engine/render/egl_context.hpp"
-#include "engine/render/gl.hpp"
-#include "engine/render/shaders.hpp"
-#include "engine/render/x11_window.hpp"
+#include "drape/engine/render/egl_context.hpp"
+#include "drape/engine/render/gl.hpp"
+#include "drape/engine/render/shaders.hpp"
+#include "drape/engine/render/x11_window.hpp"
 
 namespace drape {
 

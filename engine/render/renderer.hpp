@@ -17,12 +17,12 @@
 #include <memory>
 #include <string>
 
-#include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
-#include "engine/render/camera.hpp"
-#include "engine/render/draw_list.hpp"
-#include "engine/render/image.hpp"
-#include "engine/render/input.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/engine/render/camera.hpp"
+#include "drape/engine/render/draw_list.hpp"
+#include "drape/engine/render/image.hpp"
+#include "drape/engine/render/input.hpp"
 
 namespace drape {
 

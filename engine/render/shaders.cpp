@@ -2,7 +2,7 @@
 // from the right back, a sky/ground hemisphere ambient; linear RGB in, a soft shoulder
 // x(1 + x/4)/(1 + x), then gamma 2 (sqrt) out: the frame buffer is plain RGBA8, and these
 // cost little on a software rasteriser (tone_map() in renderer.cpp is the same curve).
-#include "engine/render/shaders.hpp"
+#include "drape/engine/render/shaders.hpp"
 
 #include <string>
 #include <vector>

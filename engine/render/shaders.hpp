@@ -3,8 +3,8 @@
 
 #include <string_view>
 
-#include "engine/core/error.hpp"
-#include "engine/render/gl.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/render/gl.hpp"
 
 namespace drape::render_detail {
 

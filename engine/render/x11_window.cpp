@@ -1,4 +1,4 @@
-#include "engine/render/x11_window.hpp"
+#include "drape/engine/render/x11_window.hpp"
 
 #include <cstdlib>
 

@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "engine/core/error.hpp"
-#include "engine/render/input.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/render/input.hpp"
 
 namespace drape::render_detail {
 

@@ -1,12 +1,12 @@
 // One character's animation update: see animation.hpp.
-#include "systems/character/animation.hpp"
+#include "drape/systems/character/animation.hpp"
 
 #include <cmath>
 
-#include "components/animation_player.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 

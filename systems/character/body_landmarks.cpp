@@ -1,13 +1,13 @@
 // Body landmarks from skeleton and skin: see body_landmarks.hpp.
-#include "systems/character/body_landmarks.hpp"
+#include "drape/systems/character/body_landmarks.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "engine/assets/skinning.hpp"
-#include "systems/character/ellipsoid_fit.hpp"
+#include "drape/engine/assets/skinning.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 
 namespace drape {
 

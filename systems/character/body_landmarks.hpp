@@ -26,11 +26,11 @@
 //    chest: the widest trunk section between waist and underarm.
 #pragma once
 
-#include "components/body_landmarks.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "engine/assets/character_asset.hpp"
-#include "engine/core/error.hpp"
+#include "drape/components/body_landmarks.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/engine/core/error.hpp"
 
 namespace drape {
 

@@ -1,7 +1,7 @@
 // Fitting a character's body: see character_body.hpp.
-#include "systems/character/character_body.hpp"
+#include "drape/systems/character/character_body.hpp"
 
-#include "systems/character/body_landmarks.hpp"
+#include "drape/systems/character/body_landmarks.hpp"
 
 namespace drape {
 

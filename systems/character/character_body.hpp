@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "components/body_landmarks.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "engine/assets/character_asset.hpp"
-#include "engine/core/error.hpp"
-#include "systems/character/ellipsoid_fit.hpp"
+#include "drape/components/body_landmarks.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 
 namespace drape {
 

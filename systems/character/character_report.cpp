@@ -1,12 +1,12 @@
 // Character reports: see character_report.hpp.
-#include "systems/character/character_report.hpp"
+#include "drape/systems/character/character_report.hpp"
 
 #include <cstdio>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include "systems/character/pose.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 namespace {

@@ -3,9 +3,9 @@
 
 #include <string>
 
-#include "engine/assets/character_asset.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character/ellipsoid_fit.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 
 namespace drape {
 

@@ -1,12 +1,12 @@
 // One collider's update: see colliders.hpp.
-#include "systems/character/colliders.hpp"
+#include "drape/systems/character/colliders.hpp"
 
 #include <cmath>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 

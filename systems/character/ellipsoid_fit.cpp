@@ -1,5 +1,5 @@
 // Ellipsoid fitting and coverage (method §2). See ellipsoid_fit.hpp.
-#include "systems/character/ellipsoid_fit.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 
 #include <algorithm>
 #include <array>
@@ -14,9 +14,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "systems/character/ellipsoid_solver.hpp"
-#include "systems/character/pose.hpp"
-#include "systems/character/skin_surface.hpp"
+#include "drape/systems/character/ellipsoid_solver.hpp"
+#include "drape/systems/character/pose.hpp"
+#include "drape/systems/character/skin_surface.hpp"
 
 namespace drape {
 

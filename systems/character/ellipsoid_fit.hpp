@@ -61,13 +61,13 @@
 #include <string_view>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "engine/assets/animation_clip.hpp"
-#include "engine/assets/character_asset.hpp"
-#include "engine/assets/mesh_asset.hpp"
-#include "engine/assets/skeleton_asset.hpp"
-#include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/engine/assets/animation_clip.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/engine/assets/mesh_asset.hpp"
+#include "drape/engine/assets/skeleton_asset.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Ellipsoids fitted to skin samples. See ellipsoid_solver.hpp for the method.
-#include "systems/character/ellipsoid_solver.hpp"
+#include "drape/systems/character/ellipsoid_solver.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -37,8 +37,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "engine/core/math.hpp"
-#include "systems/character/skin_surface.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/systems/character/skin_surface.hpp"
 
 namespace drape::fitting {
 

@@ -1,5 +1,5 @@
 // Sampling clips into local poses (method §1.1). See pose.hpp.
-#include "systems/character/pose.hpp"
+#include "drape/systems/character/pose.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -12,10 +12,10 @@
 #include <span>
 #include <vector>
 
-#include "engine/assets/animation_clip.hpp"
-#include "engine/assets/skeleton_asset.hpp"
-#include "engine/assets/skinning.hpp"  // compose_pose, skinning_matrices, skin_mesh: the rest of a frame
-#include "engine/core/math.hpp"
+#include "drape/engine/assets/animation_clip.hpp"
+#include "drape/engine/assets/skeleton_asset.hpp"
+#include "drape/engine/assets/skinning.hpp"  // compose_pose, skinning_matrices, skin_mesh: the rest of a frame
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Skin surface queries and samples. See skin_surface.hpp.
-#include "systems/character/skin_surface.hpp"
+#include "drape/systems/character/skin_surface.hpp"
 
 #include <algorithm>
 #include <cmath>

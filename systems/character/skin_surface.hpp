@@ -15,7 +15,7 @@
 #include <span>
 #include <vector>
 
-#include "engine/core/math.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

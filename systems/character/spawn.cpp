@@ -1,18 +1,18 @@
 // Spawning characters: see spawn.hpp.
-#include "systems/character/spawn.hpp"
+#include "drape/systems/character/spawn.hpp"
 
 #include <cmath>
 
-#include "components/animation_player.hpp"
-#include "components/body_landmarks.hpp"
-#include "components/character.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
-#include "engine/assets/character_import.hpp"
-#include "systems/character/animation.hpp"
-#include "systems/character/colliders.hpp"
-#include "systems/character/ellipsoid_fit.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/body_landmarks.hpp"
+#include "drape/components/character.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/animation.hpp"
+#include "drape/systems/character/colliders.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 

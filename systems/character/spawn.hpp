@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/transform.hpp"
-#include "engine/assets/character_asset.hpp"
-#include "engine/core/error.hpp"
-#include "engine/core/registry.hpp"
-#include "systems/character/character_body.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/engine/assets/character_asset.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/character/character_body.hpp"
 
 namespace drape {
 

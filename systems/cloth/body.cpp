@@ -1,10 +1,10 @@
 // Collider frames for the cloth (method §2, §5); see body.hpp for conventions.
-#include "systems/cloth/body.hpp"
+#include "drape/systems/cloth/body.hpp"
 
 #include <bit>
 #include <cstdint>
 
-#include "systems/cloth/collision.hpp"
+#include "drape/systems/cloth/collision.hpp"
 
 namespace drape {
 

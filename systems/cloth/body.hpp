@@ -12,11 +12,11 @@
 #include <span>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "systems/cloth/garment_solver.hpp"
-#include "engine/core/math.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

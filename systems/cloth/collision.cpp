@@ -1,5 +1,5 @@
 // Particle-ellipsoid collision (method §5); step order in collision.hpp.
-#include "systems/cloth/collision.hpp"
+#include "drape/systems/cloth/collision.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 #include <optional>
 #include <utility>
 
-#include "systems/cloth/body.hpp"
+#include "drape/systems/cloth/body.hpp"
 
 namespace drape {
 namespace {

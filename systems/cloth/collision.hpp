@@ -54,9 +54,9 @@
 #include <utility>
 #include <vector>
 
-#include "components/garment.hpp"
-#include "systems/cloth/garment_solver.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

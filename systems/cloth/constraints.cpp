@@ -1,5 +1,5 @@
 // Constraints in compliance form; step order in constraints.hpp.
-#include "systems/cloth/constraints.hpp"
+#include "drape/systems/cloth/constraints.hpp"
 
 #include <algorithm>
 #include <array>

@@ -23,8 +23,8 @@
 #include <span>
 #include <vector>
 
-#include "components/garment.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -9,9 +9,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "components/garment.hpp"
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_solver.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
 
 namespace drape {
 

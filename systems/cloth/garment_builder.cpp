@@ -1,5 +1,5 @@
 // Garment builders (method §3.2, §3.5); placement rules in garment_builder.hpp.
-#include "systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,18 +9,18 @@
 #include <sstream>
 #include <string>
 
-#include "components/body_landmarks.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
-#include "components/transform.hpp"
-#include "systems/character/body_landmarks.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
-#include "systems/cloth/garment_parameters.hpp"
-#include "systems/cloth/garment_parts.hpp"
-#include "systems/cloth/garment_step.hpp"
-#include "systems/cloth/pins.hpp"
+#include "drape/components/body_landmarks.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/character/body_landmarks.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
+#include "drape/systems/cloth/garment_parts.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/pins.hpp"
 
 namespace drape {
 namespace {

@@ -25,9 +25,9 @@
 #include <span>
 #include <string_view>
 
-#include "components/garment.hpp"
-#include "engine/core/error.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

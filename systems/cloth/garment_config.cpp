@@ -1,11 +1,11 @@
 // Configuration changes; see garment_config.hpp.
-#include "systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth/garment_config.hpp"
 
 #include <algorithm>
 #include <string>
 
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_solver.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
 
 namespace drape {
 namespace {

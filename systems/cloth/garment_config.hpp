@@ -4,9 +4,9 @@
 // depended on the old values.
 #pragma once
 
-#include "components/garment.hpp"
-#include "engine/core/error.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

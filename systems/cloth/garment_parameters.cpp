@@ -3,7 +3,7 @@
 // Ranges are the builder's: every value in them builds a garment that steps with finite
 // values (the edges were tried on the walking body of the cloth tests). The upper bounds
 // keep float arithmetic, not the cloth, from deciding what happens (docs/robustness.md).
-#include "systems/cloth/garment_parameters.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 #include <algorithm>
 #include <cmath>

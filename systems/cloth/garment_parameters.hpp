@@ -18,9 +18,9 @@
 #include <string_view>
 #include <variant>
 
-#include "components/garment.hpp"
-#include "engine/core/error.hpp"
-#include "systems/cloth/garment_builder.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // A big garment's work in fixed parts; see garment_parts.hpp.
-#include "systems/cloth/garment_parts.hpp"
+#include "drape/systems/cloth/garment_parts.hpp"
 
 #include <algorithm>
 

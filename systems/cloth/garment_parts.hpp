@@ -25,8 +25,8 @@
 #include <tbb/partitioner.h>
 #include <tbb/global_control.h>
 
-#include "components/garment.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -1,12 +1,12 @@
 // Garment quality after a frame; conventions in garment_quality.hpp.
-#include "systems/cloth/garment_quality.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
 
 namespace drape {
 

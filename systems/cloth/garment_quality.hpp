@@ -19,9 +19,9 @@
 #include <span>
 #include <vector>
 
-#include "components/garment.hpp"
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_solver.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
 
 namespace drape {
 

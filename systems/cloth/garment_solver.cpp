@@ -1,10 +1,10 @@
 // The cloth module's per-garment caches; see garment_solver.hpp.
-#include "systems/cloth/garment_solver.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
 
 #include <algorithm>
 #include <limits>
 
-#include "systems/cloth/integrator.hpp"
+#include "drape/systems/cloth/integrator.hpp"
 
 namespace drape {
 

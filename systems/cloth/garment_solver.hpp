@@ -12,10 +12,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "components/garment.hpp"
-#include "engine/core/math.hpp"
-#include "systems/cloth/constraints.hpp"
-#include "systems/cloth/garment_parts.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/systems/cloth/constraints.hpp"
+#include "drape/systems/cloth/garment_parts.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Per-garment stages of the cloth systems (method §3-§5); order in garment_step.hpp.
-#include "systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 #include <algorithm>
 #include <array>
@@ -8,13 +8,13 @@
 #include <cstdio>
 #include <span>
 
-#include "components/ellipsoid_collider.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
-#include "systems/cloth/integrator.hpp"
-#include "systems/cloth/pins.hpp"
-#include "systems/cloth/constraints.hpp"
-#include "systems/cloth/weft.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
+#include "drape/systems/cloth/integrator.hpp"
+#include "drape/systems/cloth/pins.hpp"
+#include "drape/systems/cloth/constraints.hpp"
+#include "drape/systems/cloth/weft.hpp"
 
 namespace drape {
 

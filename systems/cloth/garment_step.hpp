@@ -27,10 +27,10 @@
 
 #include <functional>
 
-#include "components/garment.hpp"
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_solver.hpp"
-#include "systems/cloth/substeps.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
+#include "drape/systems/cloth/substeps.hpp"
 
 namespace drape {
 

@@ -1,5 +1,5 @@
 // Explicit prediction in the anchor frame (method §3.3, §3.4); conventions in integrator.hpp.
-#include "systems/cloth/integrator.hpp"
+#include "drape/systems/cloth/integrator.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -25,8 +25,8 @@
 // Pinned particles (inverse mass 0) are left to the pins.
 #pragma once
 
-#include "components/garment.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

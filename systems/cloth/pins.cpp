@@ -1,14 +1,14 @@
 // Fitting-zone pins (method §3.5); conventions in pins.hpp.
-#include "systems/cloth/pins.hpp"
+#include "drape/systems/cloth/pins.hpp"
 
 #include <string>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
-#include "systems/cloth/garment_parts.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
+#include "drape/systems/cloth/garment_parts.hpp"
 
 namespace drape {
 

@@ -11,11 +11,11 @@
 //             model space; T is the character's Transform)
 #pragma once
 
-#include "components/garment.hpp"
-#include "systems/cloth/garment_solver.hpp"
-#include "engine/core/error.hpp"
-#include "engine/core/math.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/math.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape {
 

@@ -1,13 +1,13 @@
 // The substep rule (method §3.4); see substeps.hpp.
-#include "systems/cloth/substeps.hpp"
+#include "drape/systems/cloth/substeps.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
 
-#include "components/ellipsoid_collider.hpp"
-#include "systems/cloth/body.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/systems/cloth/body.hpp"
 
 namespace drape {
 namespace {

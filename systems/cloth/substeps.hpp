@@ -13,9 +13,9 @@
 // Walking adds a second substep when a thigh swings faster than ~2.4 m/s relative to the hips.
 #pragma once
 
-#include "components/garment.hpp"
-#include "engine/core/registry.hpp"
-#include "systems/cloth/garment_solver.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
 
 namespace drape {
 

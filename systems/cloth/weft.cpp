@@ -1,5 +1,5 @@
 // Layer-2 particles carried by layer 1 (method §4.2); see weft.hpp.
-#include "systems/cloth/weft.hpp"
+#include "drape/systems/cloth/weft.hpp"
 
 namespace drape {
 

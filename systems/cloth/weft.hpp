@@ -17,8 +17,8 @@
 #include <cstdint>
 #include <span>
 
-#include "components/garment.hpp"
-#include "engine/core/math.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/core/math.hpp"
 
 namespace drape {
 

@@ -3,7 +3,7 @@
 
 #include <fstream>
 
-#include "engine/assets/character_import.hpp"
+#include "drape/engine/assets/character_import.hpp"
 #include "tests/character/test_character_file.hpp"
 
 namespace drape {

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <string_view>
 
-#include "engine/assets/character_import.hpp"
-#include "systems/character/body_landmarks.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/body_landmarks.hpp"
 #include "tests/shared_assets.hpp"
 
 namespace drape {

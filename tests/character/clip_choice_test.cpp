@@ -4,10 +4,10 @@
 
 #include <filesystem>
 
-#include "components/animation_player.hpp"
-#include "engine/assets/character_import.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character/spawn.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/spawn.hpp"
 #include "tests/character/test_character_file.hpp"
 
 namespace drape {

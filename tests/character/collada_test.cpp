@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "engine/assets/character_import.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/pose.hpp"
 #include "tests/character/test_character_file.hpp"
 
 namespace drape {

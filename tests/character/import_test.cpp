@@ -1,12 +1,12 @@
 // Import normalisation on small characters with known contents (test_character_file.hpp).
-#include "engine/assets/character_import.hpp"
+#include "drape/engine/assets/character_import.hpp"
 
 #include <algorithm>
 
 #include <gtest/gtest.h>
 
-#include "systems/character/character_body.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/pose.hpp"
 #include "tests/character/test_character_file.hpp"
 
 namespace drape {

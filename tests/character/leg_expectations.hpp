@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "systems/character/character_body.hpp"
+#include "drape/systems/character/character_body.hpp"
 
 namespace drape::test {
 

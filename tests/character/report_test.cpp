@@ -3,9 +3,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/assets/character_import.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character/character_report.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/character_report.hpp"
 #include "tests/character/test_character_file.hpp"
 
 namespace drape {

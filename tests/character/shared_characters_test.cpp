@@ -5,12 +5,12 @@
 
 #include <filesystem>
 
-#include "engine/assets/character_import.hpp"
+#include "drape/engine/assets/character_import.hpp"
 #include "tests/character/leg_expectations.hpp"
 #include "tests/shared_assets.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character/character_report.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/character_report.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 namespace {

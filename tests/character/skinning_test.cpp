@@ -5,7 +5,7 @@
 #include <limits>
 #include <random>
 
-#include "systems/character/pose.hpp"
+#include "drape/systems/character/pose.hpp"
 
 namespace drape {
 namespace {

@@ -9,11 +9,11 @@
 #include <numbers>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
-#include "systems/cloth/garment_step.hpp"
-#include "systems/cloth_systems.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth_systems.hpp"
 
 namespace drape::test {
 

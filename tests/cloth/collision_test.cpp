@@ -8,11 +8,11 @@
 #include <functional>
 
 #include "analytic_body.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_step.hpp"
-#include "systems/cloth/substeps.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/substeps.hpp"
 
 namespace drape {
 namespace {

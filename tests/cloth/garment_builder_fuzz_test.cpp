@@ -11,10 +11,10 @@
 #include <sstream>
 #include <string>
 
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
-#include "systems/cloth_systems.hpp"
-#include "systems/cloth/garment_builder.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/systems/cloth_systems.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
 namespace {

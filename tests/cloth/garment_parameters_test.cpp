@@ -7,8 +7,8 @@
 #include <set>
 #include <string>
 
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_parameters.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape {
 namespace {

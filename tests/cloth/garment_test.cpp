@@ -6,17 +6,17 @@
 #include <tbb/global_control.h>
 
 #include "analytic_body.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
-#include "components/transform.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth_systems.hpp"
-#include "systems/cloth/collision.hpp"
-#include "systems/cloth/constraints.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_config.hpp"
-#include "systems/cloth/garment_step.hpp"
-#include "systems/cloth/pins.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth_systems.hpp"
+#include "drape/systems/cloth/collision.hpp"
+#include "drape/systems/cloth/constraints.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/pins.hpp"
 
 namespace drape {
 namespace {

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "systems/cloth/constraints.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/integrator.hpp"
-#include "systems/cloth_systems.hpp"
+#include "drape/systems/cloth/constraints.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/integrator.hpp"
+#include "drape/systems/cloth_systems.hpp"
 
 namespace drape {
 namespace {

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "analytic_body.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape {
 namespace {

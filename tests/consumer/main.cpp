@@ -1,8 +1,8 @@
 // Links against the installed Drape package and runs one scheduled frame.
 #include <cstdio>
 
-#include "engine/core/registry.hpp"
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 struct Spin {
     float angle = 0;

@@ -1,4 +1,4 @@
-#include "engine/core/profiler.hpp"
+#include "drape/engine/core/profiler.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <thread>
 
-#include "engine/core/scheduler.hpp"
+#include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
 namespace {

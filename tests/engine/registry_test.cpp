@@ -1,4 +1,4 @@
-#include "engine/core/registry.hpp"
+#include "drape/engine/core/registry.hpp"
 
 #include <gtest/gtest.h>
 

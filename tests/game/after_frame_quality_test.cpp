@@ -6,9 +6,9 @@
 
 #include <filesystem>
 
-#include "game/sample_scene.hpp"
-#include "game/stats.hpp"
-#include "game/world.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/stats.hpp"
+#include "drape/game/world.hpp"
 
 namespace drape {
 namespace {

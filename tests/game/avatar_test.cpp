@@ -1,10 +1,10 @@
 // The default avatar (game/avatar_generator.hpp): deterministic, the committed file is the
 // generator's output, a plausible body and walk, and it loads through the same import path
 // as any other character with fitted ellipsoids that cover it.
-#include "game/avatar_generator.hpp"
-#include "game/sample_scene.hpp"
-#include "game/stats.hpp"
-#include "game/world.hpp"
+#include "drape/game/avatar_generator.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/stats.hpp"
+#include "drape/game/world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,12 +20,12 @@
 #include <string>
 #include <utility>
 
-#include "components/garment.hpp"
-#include "engine/assets/character_import.hpp"
-#include "engine/assets/skinning.hpp"
-#include "systems/character/character_body.hpp"
-#include "systems/character/character_report.hpp"
-#include "systems/character/pose.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/engine/assets/character_import.hpp"
+#include "drape/engine/assets/skinning.hpp"
+#include "drape/systems/character/character_body.hpp"
+#include "drape/systems/character/character_report.hpp"
+#include "drape/systems/character/pose.hpp"
 #include "tests/character/leg_expectations.hpp"
 #include "tests/game/character_contract.hpp"
 

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "game/stats.hpp"
+#include "drape/game/stats.hpp"
 
 namespace drape::test {
 

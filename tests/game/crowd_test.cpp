@@ -7,15 +7,15 @@
 #include <filesystem>
 #include <vector>
 
-#include "components/animation_player.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/skinned_mesh.hpp"
-#include "game/asset_paths.hpp"
-#include "game/sample_scene.hpp"
-#include "game/scene_file.hpp"
-#include "game/world.hpp"
+#include "drape/components/animation_player.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/game/asset_paths.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/scene_file.hpp"
+#include "drape/game/world.hpp"
 
 namespace drape {
 namespace {

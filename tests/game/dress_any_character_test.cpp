@@ -10,12 +10,12 @@
 #include <filesystem>
 #include <utility>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "game/stats.hpp"
-#include "game/world.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/cloth/collision.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/game/stats.hpp"
+#include "drape/game/world.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/cloth/collision.hpp"
 #include "tests/game/character_contract.hpp"
 #include "tests/shared_assets.hpp"
 

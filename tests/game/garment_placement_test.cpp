@@ -6,15 +6,15 @@
 
 #include <filesystem>
 
-#include "components/body_landmarks.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "game/avatar_generator.hpp"
-#include "game/sample_scene.hpp"
-#include "game/world.hpp"
-#include "systems/character/body_landmarks.hpp"
-#include "systems/cloth/garment_quality.hpp"
+#include "drape/components/body_landmarks.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/game/avatar_generator.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/world.hpp"
+#include "drape/systems/character/body_landmarks.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 #include "tests/shared_assets.hpp"
 
 namespace drape {

@@ -1,6 +1,6 @@
 // How commands write files (game/output_files.hpp): never over an existing file without
 // consent, and through a partial file renamed onto the target.
-#include "game/output_files.hpp"
+#include "drape/game/output_files.hpp"
 
 #include <gtest/gtest.h>
 

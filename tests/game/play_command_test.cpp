@@ -11,9 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "game/asset_paths.hpp"
-#include "game/world.hpp"
-#include "game/video.hpp"
+#include "drape/game/asset_paths.hpp"
+#include "drape/game/world.hpp"
+#include "drape/game/video.hpp"
 #include "tests/character/test_character_file.hpp"
 
 namespace drape {

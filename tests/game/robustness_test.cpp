@@ -15,12 +15,12 @@
 #include <filesystem>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "systems/cloth/garment_quality.hpp"
-#include "components/transform.hpp"
-#include "game/sample_scene.hpp"
-#include "game/world.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/world.hpp"
 
 namespace drape {
 namespace {

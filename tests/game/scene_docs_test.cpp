@@ -7,7 +7,7 @@
 #include <iterator>
 #include <string>
 
-#include "game/scene_garment_parameters.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
 
 namespace drape {
 namespace {

@@ -7,7 +7,7 @@
 #include <random>
 #include <string>
 
-#include "game/scene_file.hpp"
+#include "drape/game/scene_file.hpp"
 
 namespace drape {
 namespace {

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "game/scene_file.hpp"
-#include "game/scene_garment_parameters.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/garment_parameters.hpp"
+#include "drape/game/scene_file.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape {
 namespace {

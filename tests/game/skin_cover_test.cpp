@@ -9,15 +9,15 @@
 #include <string>
 #include <vector>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skin_cover.hpp"
-#include "components/skinned_mesh.hpp"
-#include "game/sample_scene.hpp"
-#include "game/world.hpp"
-#include "systems/cloth/body.hpp"
-#include "systems/skin_cover_system.hpp"
-#include "systems/skinning_system.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skin_cover.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/world.hpp"
+#include "drape/systems/cloth/body.hpp"
+#include "drape/systems/skin_cover_system.hpp"
+#include "drape/systems/skinning_system.hpp"
 #include "tests/shared_assets.hpp"
 
 namespace drape {

@@ -8,9 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "components/garment.hpp"
-#include "game/stats.hpp"
-#include "systems/cloth/garment_builder.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/game/stats.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
 namespace {

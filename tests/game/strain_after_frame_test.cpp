@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "components/garment.hpp"
-#include "game/sample_scene.hpp"
-#include "game/world.hpp"
-#include "systems/cloth/garment_quality.hpp"
-#include "systems/cloth/garment_solver.hpp"
-#include "systems/cloth/garment_step.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/world.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
+#include "drape/systems/cloth/garment_solver.hpp"
+#include "drape/systems/cloth/garment_step.hpp"
 
 namespace drape {
 namespace {

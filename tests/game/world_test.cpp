@@ -7,17 +7,17 @@
 #include <fstream>
 #include <random>
 
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skeleton.hpp"
-#include "components/transform.hpp"
-#include "game/asset_paths.hpp"
-#include "game/sample_scene.hpp"
-#include "game/scene_file.hpp"
-#include "game/world.hpp"
-#include "game/scene_garment_parameters.hpp"
-#include "systems/cloth/garment_builder.hpp"
-#include "systems/cloth/substeps.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/transform.hpp"
+#include "drape/game/asset_paths.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/scene_file.hpp"
+#include "drape/game/world.hpp"
+#include "drape/game/scene_garment_parameters.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+#include "drape/systems/cloth/substeps.hpp"
 
 namespace drape {
 namespace {

@@ -9,9 +9,9 @@
 #define STB_IMAGE_STATIC
 #include <stb/stb_image.h>
 
-#include "engine/render/camera.hpp"
-#include "engine/render/image.hpp"
-#include "engine/render/renderer.hpp"
+#include "drape/engine/render/camera.hpp"
+#include "drape/engine/render/image.hpp"
+#include "drape/engine/render/renderer.hpp"
 
 namespace drape {
 namespace {

@@ -8,10 +8,10 @@
 #include <limits>
 #include <set>
 
-#include "engine/core/scheduler.hpp"
-#include "engine/render/renderer.hpp"
-#include "engine/render/shaders.hpp"
-#include "systems/render_system.hpp"
+#include "drape/engine/core/scheduler.hpp"
+#include "drape/engine/render/renderer.hpp"
+#include "drape/engine/render/shaders.hpp"
+#include "drape/systems/render_system.hpp"
 #include "tests/render/test_scene.hpp"
 
 namespace drape {

@@ -13,8 +13,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "engine/render/renderer.hpp"
-#include "systems/render_system.hpp"
+#include "drape/engine/render/renderer.hpp"
+#include "drape/systems/render_system.hpp"
 #include "tests/render/test_scene.hpp"
 
 // After Eigen: Xlib defines macros (Success, None, Status) that clash with it.

@@ -7,13 +7,13 @@
 #include <set>
 #include <string>
 
-#include "components/garment.hpp"
-#include "components/skinned_mesh.hpp"
-#include "engine/render/renderer.hpp"
-#include "game/sample_scene.hpp"
-#include "game/world.hpp"
-#include "systems/skin_cover_system.hpp"
-#include "systems/skinning_system.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/engine/render/renderer.hpp"
+#include "drape/game/sample_scene.hpp"
+#include "drape/game/world.hpp"
+#include "drape/systems/skin_cover_system.hpp"
+#include "drape/systems/skinning_system.hpp"
 
 namespace drape {
 namespace {

@@ -5,11 +5,11 @@
 #include <memory>
 #include <numbers>
 
-#include "components/character.hpp"
-#include "components/ellipsoid_collider.hpp"
-#include "components/garment.hpp"
-#include "components/skinned_mesh.hpp"
-#include "engine/core/registry.hpp"
+#include "drape/components/character.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/engine/core/registry.hpp"
 
 namespace drape::test {
 
