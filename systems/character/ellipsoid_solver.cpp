@@ -247,14 +247,27 @@ struct Solver {
         return out;
     }
 
-    // Whether a point is inside a piece other than k (then it is not on the union's surface).
-    bool buried(std::size_t k, const Vector3d& x) const {
+    // The pieces other than k that may hold a point of `e`'s surface (piece k's shape, or
+    // one tried for it): those whose bounding sphere comes near e's, with a centimetre to
+    // spare (far beyond rounding). A point of e's surface lies within e's largest radius of
+    // its centre, so no other piece can hold it.
+    std::vector<std::size_t> neighbours(std::size_t k, const Ellipsoid& e) const {
+        std::vector<std::size_t> out;
         for (std::size_t j = 0; j < pieces.size(); ++j) {
             if (j == k) continue;
             const Ellipsoid& o = pieces[j].shape;
-            if ((o.axes.transpose() * (x - o.center)).cwiseQuotient(o.radii).squaredNorm() < 1) return true;
+            if ((o.center - e.center).norm() <= o.radii.maxCoeff() + e.radii.maxCoeff() + 0.01) out.push_back(j);
         }
-        return false;
+        return out;
+    }
+
+    // Whether a point of a surface is inside one of `others` (then it is not on the union's
+    // surface).
+    bool buried(const std::vector<std::size_t>& others, const Vector3d& x) const {
+        return std::any_of(others.begin(), others.end(), [&](std::size_t j) {
+            const Ellipsoid& o = pieces[j].shape;
+            return (o.axes.transpose() * (x - o.center)).cwiseQuotient(o.radii).squaredNorm() < 1;
+        });
     }
 
     // Residuals of a shape for piece k: cover per candidate, then bulge per surface point.
@@ -275,10 +288,11 @@ struct Solver {
             r[Eigen::Index(i)] = (s.is_vertex ? 1.0 : settings.face_sample_weight) * soft_excess(d, settings.cover_margin_m, settings.huber_m);
         }
         const double unit_area = 4 * std::numbers::pi / double(m) * e.radii.prod();
+        const std::vector<std::size_t> others = neighbours(k, e);
         for (std::size_t i = 0; i < m; ++i) {
             const Vector3d x = e.center + e.axes * e.radii.cwiseProduct(sphere[i]);
             double loose = 0, tight = 0;
-            if (!buried(k, x)) {
+            if (!buried(others, x)) {
                 const double area = unit_area * sphere[i].cwiseQuotient(e.radii).norm();
                 const double out = field(x);
                 loose = std::sqrt(settings.bulge_weight * area / sample_area_m2) * soft_excess(out, settings.bulge_free_m + pieces[k].extra_free_m, settings.huber_m);
@@ -420,9 +434,10 @@ struct Solver {
         for (std::size_t k = 0; k < pieces.size(); ++k) {
             const Ellipsoid& e = pieces[k].shape;
             const double unit_area = 4 * std::numbers::pi / double(sphere.size()) * e.radii.prod();
+            const std::vector<std::size_t> others = neighbours(k, e);
             for (const Vector3d& u : sphere) {
                 const Vector3d x = e.center + e.axes * e.radii.cwiseProduct(u);
-                if (buried(k, x)) continue;
+                if (buried(others, x)) continue;
                 const double area = unit_area * u.cwiseQuotient(e.radii).norm();
                 f.surface_m2 += area;
                 if (field(x) > settings.bulge_limit_m) f.bulging_m2[k] += area;
