@@ -12,6 +12,7 @@
 #include "drape/components/skeleton.hpp"
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/body_cache.hpp"
 #include "drape/game/collider_overrides.hpp"
 #include "drape/game/scene_file.hpp"
 #include "drape/game/scene_garment_parameters.hpp"
@@ -37,6 +38,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
+
 
 }  // namespace
 
@@ -71,6 +73,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         CharacterBody body;
     };
     std::map<fs::path, Loaded> loaded;
+    const fs::path body_cache = !options.body_cache.empty() ? options.body_cache : body_cache_from_environment();
     for (std::size_t i = 0; i < scene.characters.size(); ++i) {
         const CharacterDescription& c = scene.characters[i];
         const std::string field = "characters[" + std::to_string(i) + "].file";
@@ -78,7 +81,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         if (!character.asset) {
             auto imported = import_character(c.file);
             if (!imported) return fail(located(c.where, field, imported.error().message));
-            auto body = fit_character_body(**imported);
+            auto body = fit_character_body(**imported, c.file, FitOptions{}, body_cache);
             if (!body) return fail(located(c.where, field, body.error().message));
             character = {*imported, std::move(*body)};
             world.warnings.insert(world.warnings.end(), character.asset->warnings.begin(), character.asset->warnings.end());

@@ -43,6 +43,9 @@ struct WorldOptions {
     bool window = false;             ///< Render into an X11 window instead of off-screen.
     int width = 1280, height = 720;  ///< Frame size, px.
     bool profile = true;             ///< Time every system run (the frame budget table).
+    /// Folder where fitted bodies are kept between runs (systems/character/body_cache.hpp); empty: the
+    /// folder DRAPE_BODY_CACHE names, or none.
+    std::filesystem::path body_cache;
 };
 
 /// A running scene: its description, registry, scheduler with the systems, its entities,

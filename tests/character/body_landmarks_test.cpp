@@ -9,6 +9,7 @@
 #include "drape/engine/assets/character_import.hpp"
 #include "drape/systems/character/body_landmarks.hpp"
 #include "tests/shared_assets.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -48,7 +49,7 @@ void expect_humanoid(const BodyLandmarks& l, const std::string& file) {
 }
 
 TEST(BodyLandmarks, DefaultAvatarByBoneNames) {
-    const fs::path file = fs::path(DRAPE_SOURCE_DIR) / "assets/avatar.glb";
+    const fs::path file = test::source_dir() / "assets/avatar.glb";
     ASSERT_TRUE(fs::exists(file)) << "assets/avatar.glb is part of the project";
     const auto c = load(file);
     ASSERT_TRUE(c);
@@ -64,7 +65,7 @@ TEST(BodyLandmarks, DefaultAvatarByBoneNames) {
 TEST(BodyLandmarks, SharedHumanoidsByTopology) {
     for (const char* relative : {"characters/male_casual/Male_Casual.fbx", "characters/female_alternative/Female_Alternative.fbx",
                                  "characters/robot_expressive/RobotExpressive.glb"}) {
-        const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / relative;
+        const fs::path file = test::shared_assets() / relative;
         DRAPE_REQUIRE_SHARED(file);
         const auto c = load(file);
         ASSERT_TRUE(c);
@@ -82,7 +83,7 @@ TEST(BodyLandmarks, SharedHumanoidsByTopology) {
 }
 
 TEST(BodyLandmarks, ANonHumanoidIsAnErrorNamingTheFile) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/rigged_simple/RiggedSimple.glb";
+    const fs::path file = test::shared_assets() / "characters/rigged_simple/RiggedSimple.glb";
     DRAPE_REQUIRE_SHARED(file);
     const auto c = load(file);
     ASSERT_TRUE(c);

@@ -2,7 +2,14 @@
 // differences over the fixed step (method §2, §3.3); fitting and coverage.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <string>
 
 #include "drape/components/animation_player.hpp"
 #include "drape/components/character.hpp"
@@ -12,6 +19,7 @@
 #include "drape/components/transform.hpp"
 #include "drape/engine/assets/character_import.hpp"
 #include "drape/engine/core/scheduler.hpp"
+#include "drape/systems/character/body_cache.hpp"
 #include "drape/systems/character/character_body.hpp"
 #include "drape/systems/character/colliders.hpp"
 #include "drape/systems/character/pose.hpp"
@@ -19,22 +27,36 @@
 #include "drape/systems/character_systems.hpp"
 #include "drape/systems/collider_system.hpp"
 #include "tests/character/test_character_file.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
 
+// The test column, kept in the build tree under a name of its bytes (written whole, the
+// same bytes on every run), so that its body comes from the body cache after its first fit.
 std::shared_ptr<const CharacterAsset> column(const test::TestCharacter& spec = {}) {
+    namespace fs = std::filesystem;
     const auto dir = test::temp_dir("collider");
     write_test_character(spec, dir / "column.gltf");
-    auto r = import_character(dir / "column.gltf");
-    std::filesystem::remove_all(dir);
+    std::ifstream in(dir / "column.gltf", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    fs::remove_all(dir);
+    const fs::path kept = test::binary_dir() / "test-characters" / ("column-" + std::to_string(std::hash<std::string>{}(bytes)));
+    fs::create_directories(kept);
+    if (!fs::exists(kept / "column.gltf")) {
+        const fs::path temporary = kept / ("column.gltf." + std::to_string(::getpid()));
+        std::ofstream(temporary, std::ios::binary) << bytes;
+        fs::rename(temporary, kept / "column.gltf");
+    }
+    auto r = import_character(kept / "column.gltf");
     EXPECT_TRUE(r) << (r ? "" : r.error().message);
     return r ? *r : nullptr;
 }
 
-// The fitted body of a character (default fit options).
+// The fitted body of a character imported from its file (default fit options), through
+// the tests' body cache.
 CharacterBody body_of(const CharacterAsset& c) {
-    auto body = fit_character_body(c);
+    auto body = fit_character_body(c, c.source, FitOptions{}, body_cache_from_environment());
     EXPECT_TRUE(body) << (body ? "" : body.error().message);
     return body ? std::move(*body) : CharacterBody{};
 }

@@ -11,11 +11,12 @@
 #include "drape/systems/character/character_body.hpp"
 #include "drape/systems/character/character_report.hpp"
 #include "drape/systems/character/pose.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
 
-std::filesystem::path shared(const char* relative) { return std::filesystem::path(DRAPE_SHARED_ASSETS) / relative; }
+std::filesystem::path shared(const char* relative) { return test::shared_assets() / relative; }
 
 #define REQUIRE_SHARED(path) DRAPE_REQUIRE_SHARED(path)
 

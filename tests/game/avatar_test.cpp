@@ -28,11 +28,12 @@
 #include "drape/systems/character/pose.hpp"
 #include "tests/character/leg_expectations.hpp"
 #include "tests/game/character_contract.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
 
-const std::filesystem::path committed_avatar = std::filesystem::path(DRAPE_SOURCE_DIR) / "assets" / "avatar.glb";
+const std::filesystem::path committed_avatar = test::source_dir() / "assets" / "avatar.glb";
 
 // Generating takes a moment: share one model and one byte string between the tests.
 const AvatarModel& avatar() {
@@ -436,7 +437,7 @@ AvatarModel reshaped(AvatarModel m, Map map) {
 }
 
 Result<std::shared_ptr<const CharacterAsset>> import_model(const AvatarModel& m, const std::string& name) {
-    const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / ("avatar_build_" + name + ".glb");
+    const auto path = test::binary_dir() / ("avatar_build_" + name + ".glb");
     if (auto ok = write_avatar(m, path); !ok) return std::unexpected(ok.error());
     auto c = import_character(path);
     if (!c) return std::unexpected(c.error());
@@ -480,7 +481,7 @@ TEST(AvatarBuilds, FittedEllipsoidsHugShortWideAndLongLeggedBodies) {
 TEST(AvatarBuilds, AHemOverThinLegsGetsMoreLines) {
     const auto builds = unusual_builds();
     ASSERT_EQ(builds.at(0).first, "short");
-    const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / "avatar_build_short.glb";
+    const auto path = test::binary_dir() / "avatar_build_short.glb";
     ASSERT_TRUE(write_avatar(builds.at(0).second, path));
     const auto lines_of = [](const std::filesystem::path& file, std::optional<double> widths) -> Result<std::uint32_t> {
         SceneDescription scene = sample_scene();
@@ -516,7 +517,7 @@ TEST(AvatarBuilds, SkirtAndDressHoldTheContractOnTheUnusualBuilds) {
         for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
             const std::string garment = type == GarmentType::skirt ? "skirt" : "dress";
             SCOPED_TRACE(name + ", " + garment);
-            const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / ("avatar_build_" + garment + "_" + name + ".glb");
+            const auto path = test::binary_dir() / ("avatar_build_" + garment + "_" + name + ".glb");
             ASSERT_TRUE(write_avatar(model, path));
             SceneDescription scene = sample_scene();
             scene.characters.at(0).file = path;

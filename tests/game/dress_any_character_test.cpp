@@ -18,6 +18,7 @@
 #include "drape/systems/cloth/collision.hpp"
 #include "tests/game/character_contract.hpp"
 #include "tests/shared_assets.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -89,7 +90,7 @@ SceneDescription walking_in_place(const fs::path& file, GarmentType type, double
 }
 
 void dress_and_walk(const Character& c, GarmentType type) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
+    const fs::path file = test::shared_assets() / c.file;
     DRAPE_REQUIRE_SHARED(file);
     SceneDescription scene;
     scene.characters.emplace_back();
@@ -149,7 +150,7 @@ TEST(DressAnyCharacter, GarmentsHoldTheContractOnTheSharedHumanoids) {
                                                               {characters[1], GarmentType::dress},
                                                               {female, GarmentType::skirt}};
     for (const auto& [c, type] : cases) {
-        const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
+        const fs::path file = test::shared_assets() / c.file;
         DRAPE_REQUIRE_SHARED(file);
         SCOPED_TRACE(std::string(c.file) + (type == GarmentType::skirt ? ", skirt" : ", dress"));
         auto world = build_world(walking_in_place(file, type), {});
@@ -170,7 +171,7 @@ TEST(DressAnyCharacter, LinesDoNotDependOnWhereInTheWalkTheGarmentIsPutOn) {
                                                               {female, GarmentType::skirt},
                                                               {characters[1], GarmentType::skirt}};
     for (const auto& [c, type] : cases) {
-        const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / c.file;
+        const fs::path file = test::shared_assets() / c.file;
         DRAPE_REQUIRE_SHARED(file);
         std::uint32_t first = 0;
         for (const double start_s : {0.0, 0.25, 0.375, 0.625}) {
@@ -190,7 +191,7 @@ TEST(DressAnyCharacter, LinesDoNotDependOnWhereInTheWalkTheGarmentIsPutOn) {
 // under the arm, not round it (pushed the shortest way, the cloth wrapped the outside of
 // the hand and tore within ten frames: 280 % and 158 %). The first 30 frames.
 TEST(DressAnyCharacter, ADressStartedMidStrideHangsUnderTheArms) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / characters[0].file;
+    const fs::path file = test::shared_assets() / characters[0].file;
     DRAPE_REQUIRE_SHARED(file);
     for (const double start_s : {0.25, 0.625}) {
         SCOPED_TRACE("start " + std::to_string(start_s) + " s");
@@ -206,7 +207,7 @@ TEST(DressAnyCharacter, ADressStartedMidStrideHangsUnderTheArms) {
 // first step only, a spring at the knee reached 70.2 % in the seventh frame. The larger
 // budget lasts the first 1/6 s (garment_step.cpp). The first 30 frames.
 TEST(DressAnyCharacter, ADressPutOnMidStrideSettlesOntoAKnee) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / characters[1].file;
+    const fs::path file = test::shared_assets() / characters[1].file;
     DRAPE_REQUIRE_SHARED(file);
     auto world = build_world(walking_in_place(file, GarmentType::dress, 0.375), {});
     ASSERT_TRUE(world) << world.error().message;

@@ -16,6 +16,7 @@
 #include "drape/systems/character/body_landmarks.hpp"
 #include "drape/systems/cloth/garment_quality.hpp"
 #include "tests/shared_assets.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -82,7 +83,7 @@ TEST(GarmentPlacement, ASetFractionOverridesTheLandmark) {
 }
 
 TEST(GarmentPlacement, SkirtAtTheWaistOfAThirdPartyCharacter) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/female_alternative/Female_Alternative.fbx";
+    const fs::path file = test::shared_assets() / "characters/female_alternative/Female_Alternative.fbx";
     DRAPE_REQUIRE_SHARED(file);
     const Placed skirt = place(file, GarmentType::skirt);
     expect_at(skirt.ring_y, skirt.waist_y);
@@ -123,7 +124,7 @@ TEST(GarmentPlacement, ALongDressIsShortenedOnAShortBody) {
     EXPECT_GT(tall.low, Real(0.09) * tall.height);
     AvatarOptions options;
     options.height_m = 1.2;
-    const fs::path small = fs::path(DRAPE_BINARY_DIR) / "garment_placement_short.glb";
+    const fs::path small = test::binary_dir() / "garment_placement_short.glb";
     ASSERT_TRUE(write_avatar(make_default_avatar(options), small));
     const Hem shortened = hem(small, GarmentType::dress), unlimited = hem(small, GarmentType::dress, 0);
     fs::remove(small);

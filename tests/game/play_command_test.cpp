@@ -15,6 +15,7 @@
 #include "drape/game/world.hpp"
 #include "drape/game/video.hpp"
 #include "tests/character/test_character_file.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -28,8 +29,8 @@ struct PlayRun {
 
 // Runs `drape ARGS` in `folder` (shell syntax), with the project's assets.
 PlayRun drape(const std::string& args, const fs::path& folder = fs::temp_directory_path(), const std::string& env = "") {
-    const std::string command = "cd '" + folder.string() + "' && DRAPE_ASSETS='" + std::string(DRAPE_SOURCE_DIR) + "/assets' " + env +
-                                " '" + std::string(DRAPE_BINARY_DIR) + "/drape' " + args + " 2>&1";
+    const std::string command = "cd '" + folder.string() + "' && DRAPE_ASSETS='" + test::source_dir().string() + "/assets' " + env +
+                                " '" + test::binary_dir().string() + "/drape' " + args + " 2>&1";
     PlayRun run;
     std::FILE* pipe = ::popen(command.c_str(), "r");
     if (pipe == nullptr) return run;
@@ -55,7 +56,7 @@ int lines(const std::string& text) { return static_cast<int>(std::count(text.beg
 class PlayCommand : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!fs::exists(fs::path(DRAPE_BINARY_DIR) / "drape")) GTEST_SKIP() << "the drape executable is not built";
+        if (!fs::exists(test::binary_dir() / "drape")) GTEST_SKIP() << "the drape executable is not built";
         m_dir = fs::temp_directory_path() / ("drape_play_test_" + std::to_string(::getpid()) + "_" +
                                              ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::remove_all(m_dir);
@@ -82,7 +83,7 @@ TEST_F(PlayCommand, BadValuesGiveOneLineNamingTheOption) {
         {"--headless --stats no/such/folder/stats.json", "drape play: --stats: folder no/such/folder does not exist\n"},
         {"--headless --scene nothing.json", "drape play: nothing.json: no such scene file\n"},
         {"--headless --clip Moonwalk",
-         "drape play: --clip: " + std::string(DRAPE_SOURCE_DIR) + "/assets/avatar.glb: no clip named 'Moonwalk' (clips: 'Walk', 'Idle')\n"},
+         "drape play: --clip: " + test::source_dir().string() + "/assets/avatar.glb: no clip named 'Moonwalk' (clips: 'Walk', 'Idle')\n"},
     };
     for (const Case& c : cases) {
         const PlayRun run = play(c.args, m_dir);

@@ -19,6 +19,7 @@
 #include "drape/systems/skin_cover_system.hpp"
 #include "drape/systems/skinning_system.hpp"
 #include "tests/shared_assets.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -247,7 +248,7 @@ TEST(SkinCover, TheSampleSkirtCoversTheHipsAndThighs) {
 // waist also has thin pieces (1 cm): the cloth's triangles cut through them, so skin is
 // drawn in them only where no thicker one is near (skin_cover_min_radius_m).
 TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/male_casual/Male_Casual.fbx";
+    const fs::path file = test::shared_assets() / "characters/male_casual/Male_Casual.fbx";
     DRAPE_REQUIRE_SHARED(file);
     for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
         SCOPED_TRACE(type == GarmentType::skirt ? "skirt" : "dress");
@@ -273,7 +274,7 @@ TEST(SkinCover, MaleCasualsShirtStaysUnderTheSkirtAndTheDress) {
 // walk cycle: which vertices lie by a hand depends on the fitted ellipsoids, whose fit
 // rounds differently in another build.
 TEST(SkinCover, HipSkinByAHandStaysUnderTheDress) {
-    const fs::path file = fs::path(DRAPE_SHARED_ASSETS) / "characters/female_alternative/Female_Alternative.fbx";
+    const fs::path file = test::shared_assets() / "characters/female_alternative/Female_Alternative.fbx";
     DRAPE_REQUIRE_SHARED(file);
     for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
         SCOPED_TRACE(type == GarmentType::skirt ? "skirt" : "dress");

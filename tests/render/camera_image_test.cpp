@@ -12,6 +12,7 @@
 #include "drape/engine/render/camera.hpp"
 #include "drape/engine/render/image.hpp"
 #include "drape/engine/render/renderer.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -68,7 +69,7 @@ TEST(Image, PngRoundTripKeepsEveryByteTopRowFirst) {
     image.height = 3;
     image.rgba.resize(5 * 3 * 4);
     for (std::size_t i = 0; i < image.rgba.size(); ++i) image.rgba[i] = std::uint8_t(i * 7 + 3);
-    const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / "render-test-output" / "roundtrip.png";
+    const auto path = test::binary_dir() / "render-test-output" / "roundtrip.png";
     ASSERT_TRUE(write_png(image, path).has_value());
     int w = 0, h = 0, channels = 0;
     unsigned char* data = stbi_load(path.c_str(), &w, &h, &channels, 4);
@@ -88,7 +89,7 @@ TEST(Image, WritingToAnUnwritablePathNamesThePath) {
 
 TEST(Image, AnImageWhoseBytesDoNotMatchItsSizeIsRefused) {
     Image image{4, 4, std::vector<std::uint8_t>(10)};
-    auto ok = write_png(image, std::filesystem::path(DRAPE_BINARY_DIR) / "render-test-output" / "bad.png");
+    auto ok = write_png(image, test::binary_dir() / "render-test-output" / "bad.png");
     ASSERT_FALSE(ok.has_value());
     EXPECT_NE(ok.error().message.find("expected 64"), std::string::npos) << ok.error().message;
     EXPECT_FALSE(write_png(Image{}, "empty.png").has_value());

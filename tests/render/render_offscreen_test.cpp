@@ -13,6 +13,7 @@
 #include "drape/engine/render/shaders.hpp"
 #include "drape/systems/render_system.hpp"
 #include "tests/render/test_scene.hpp"
+#include "tests/test_paths.hpp"
 
 namespace drape {
 namespace {
@@ -32,7 +33,7 @@ Rgb pixel(const Image& image, const ScreenPoint& p) {
 int luminance(Rgb c) { return (2 * c.r + 5 * c.g + c.b) / 8; }
 
 void save(const Image& image, const std::string& name) {
-    const auto path = std::filesystem::path(DRAPE_BINARY_DIR) / "render-test-output" / (name + ".png");
+    const auto path = test::binary_dir() / "render-test-output" / (name + ".png");
     ASSERT_TRUE(write_png(image, path).has_value());
 }
 

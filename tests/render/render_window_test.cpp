@@ -22,6 +22,7 @@
 #include <X11/Xlib.h>
 #include <X11/Xutil.h>
 #include <X11/keysym.h>
+#include "tests/test_paths.hpp"
 #define DRAPE_TEST_HAVE_X11 1
 #endif
 
@@ -169,7 +170,7 @@ TEST(RenderWindow, OneFrameRendersInAnXvfbWindowAndReadsBack) {
     const std::uint8_t* p = image->at(int(centre->x_px), int(centre->y_px));
     EXPECT_GT(int(p[1]), int(p[0]) + 60) << "green garment expected, got " << int(p[0]) << "," << int(p[1]) << ","
                                           << int(p[2]);
-    ASSERT_TRUE(write_png(*image, std::filesystem::path(DRAPE_BINARY_DIR) / "render-test-output" / "window.png"));
+    ASSERT_TRUE(write_png(*image, test::binary_dir() / "render-test-output" / "window.png"));
 
 #ifdef DRAPE_TEST_HAVE_X11
     // Keys and a mouse drag, as a user would give them.

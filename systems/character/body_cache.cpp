@@ -1,0 +1,331 @@
+// Fitted bodies kept on disk: see body_cache.hpp.
+#include "drape/systems/character/body_cache.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+#include <vector>
+
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
+namespace drape {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A new field in any of these must be written and read below (and the format's version
+// raised); the sizes (with Eigen's alignment on x86-64) catch one added without that.
+static_assert(sizeof(FitOptions) == 88, "body_cache.cpp: add the new FitOptions field to the key");
+static_assert(sizeof(EllipsoidShape) == 64, "body_cache.cpp: write and read the new EllipsoidShape field");
+static_assert(sizeof(BodyPoint) == 28, "body_cache.cpp: write and read the new BodyPoint field");
+static_assert(sizeof(BodySection) == 40, "body_cache.cpp: write and read the new BodySection field");
+static_assert(sizeof(BodyLandmarks) == 408, "body_cache.cpp: write and read the new BodyLandmarks field");
+static_assert(sizeof(CharacterBody) == 480, "body_cache.cpp: write and read the new CharacterBody field");
+constexpr std::string_view magic = "drape fitted body 1\n";
+constexpr std::size_t encoded_ellipsoid_bytes = 4 + 12 + 16 + 12 + 1 + 4;  // as encode() writes one
+
+std::string number(double v) {
+    char buffer[64];
+    const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
+    return ec == std::errc() ? std::string(buffer, end) : "?";
+}
+
+std::int64_t mtime_ns(const fs::path& p, std::error_code& ec) {
+    const auto t = fs::last_write_time(p, ec);
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+}
+
+std::optional<std::string> read_all(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    if (!in) return std::nullopt;
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) return std::nullopt;
+    return bytes;
+}
+
+// Little helpers to write and read the body's fields in a fixed order.
+class Writer {
+public:
+    template <class T>
+    void raw(const T& v) {
+        static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+        const char* p = reinterpret_cast<const char*>(&v);
+        out.append(p, sizeof v);
+    }
+    void vec(const Vec3& v) { for (int i = 0; i < 3; ++i) raw(v[i]); }
+    void ints(const std::vector<int>& v) {
+        raw(static_cast<std::uint32_t>(v.size()));
+        for (int i : v) raw(i);
+    }
+    void text(const std::string& s) {
+        raw(static_cast<std::uint32_t>(s.size()));
+        out += s;
+    }
+    void point(const BodyPoint& p) {
+        raw(p.bone);
+        vec(p.rest_m);
+        vec(p.local_m);
+    }
+    void section(const BodySection& s) {
+        point(s.center);
+        raw(s.half_width_m);
+        raw(s.half_depth_m);
+        raw(s.girth_m);
+    }
+    void limb(const LimbChain& c) {
+        raw(c.root);
+        raw(c.middle);
+        raw(c.end);
+    }
+    std::string out;
+};
+
+class Reader {
+public:
+    explicit Reader(std::string_view in) : m_in(in) {}
+    template <class T>
+    void raw(T& v) {
+        static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+        if (m_in.size() < sizeof v) {
+            ok = false;
+            v = T{};
+            return;
+        }
+        std::memcpy(&v, m_in.data(), sizeof v);
+        m_in.remove_prefix(sizeof v);
+    }
+    void vec(Vec3& v) { for (int i = 0; i < 3; ++i) raw(v[i]); }
+    std::uint32_t count(std::size_t item_bytes) {
+        std::uint32_t n = 0;
+        raw(n);
+        if (std::size_t(n) * item_bytes > m_in.size()) {
+            ok = false;
+            return 0;
+        }
+        return n;
+    }
+    void ints(std::vector<int>& v) {
+        v.resize(count(sizeof(int)));
+        for (int& i : v) raw(i);
+    }
+    void text(std::string& s) {
+        const std::uint32_t n = count(1);
+        s.assign(m_in.substr(0, n));
+        m_in.remove_prefix(n);
+    }
+    void point(BodyPoint& p) {
+        raw(p.bone);
+        vec(p.rest_m);
+        vec(p.local_m);
+    }
+    void section(BodySection& s) {
+        point(s.center);
+        raw(s.half_width_m);
+        raw(s.half_depth_m);
+        raw(s.girth_m);
+    }
+    void limb(LimbChain& c) {
+        raw(c.root);
+        raw(c.middle);
+        raw(c.end);
+    }
+    [[nodiscard]] bool done() const { return ok && m_in.empty(); }
+    bool ok = true;
+
+private:
+    std::string_view m_in;
+};
+
+std::string encode(const CharacterBody& body) {
+    Writer w;
+    w.raw(static_cast<std::uint32_t>(body.ellipsoids.size()));
+    for (const EllipsoidShape& s : body.ellipsoids) {
+        w.raw(s.bone);
+        w.vec(s.center);
+        for (int i = 0; i < 4; ++i) w.raw(s.rotation.coeffs()[i]);
+        w.vec(s.radii_m);
+        w.raw(s.region);
+        w.raw(s.give_m);
+    }
+    w.raw(body.hip_bone);
+    w.raw(body.legs);
+    w.raw(static_cast<std::uint8_t>(body.landmarks.has_value()));
+    if (const auto& l = body.landmarks) {
+        w.vec(l->up);
+        w.vec(l->forward);
+        w.vec(l->left);
+        w.raw(l->floor_m);
+        w.raw(l->top_m);
+        w.raw(l->height_m);
+        w.raw(l->pelvis_bone);
+        w.ints(l->spine);
+        w.raw(l->chest_bone);
+        w.raw(l->head_bone);
+        for (const LimbChain* c : {&l->left_leg, &l->right_leg, &l->left_arm, &l->right_arm}) w.limb(*c);
+        w.ints(l->body_bones);
+        w.raw(l->crotch_m);
+        w.raw(l->underarm_m);
+        w.point(l->under_arms);
+        w.section(l->waist);
+        w.section(l->hips);
+        w.section(l->chest);
+        w.point(l->left_shoulder);
+        w.point(l->right_shoulder);
+        w.text(l->found_by);
+    }
+    w.text(body.landmarks_error);
+    return w.out;
+}
+
+std::optional<CharacterBody> decode(std::string_view bytes) {
+    Reader r(bytes);
+    CharacterBody body;
+    body.ellipsoids.resize(r.count(encoded_ellipsoid_bytes));
+    for (EllipsoidShape& s : body.ellipsoids) {
+        r.raw(s.bone);
+        r.vec(s.center);
+        for (int i = 0; i < 4; ++i) r.raw(s.rotation.coeffs()[i]);
+        r.vec(s.radii_m);
+        r.raw(s.region);
+        r.raw(s.give_m);
+    }
+    r.raw(body.hip_bone);
+    r.raw(body.legs);
+    std::uint8_t has_landmarks = 0;
+    r.raw(has_landmarks);
+    if (has_landmarks) {
+        BodyLandmarks& l = body.landmarks.emplace();
+        r.vec(l.up);
+        r.vec(l.forward);
+        r.vec(l.left);
+        r.raw(l.floor_m);
+        r.raw(l.top_m);
+        r.raw(l.height_m);
+        r.raw(l.pelvis_bone);
+        r.ints(l.spine);
+        r.raw(l.chest_bone);
+        r.raw(l.head_bone);
+        for (LimbChain* c : {&l.left_leg, &l.right_leg, &l.left_arm, &l.right_arm}) r.limb(*c);
+        r.ints(l.body_bones);
+        r.raw(l.crotch_m);
+        r.raw(l.underarm_m);
+        r.point(l.under_arms);
+        r.section(l.waist);
+        r.section(l.hips);
+        r.section(l.chest);
+        r.point(l.left_shoulder);
+        r.point(l.right_shoulder);
+        r.text(l.found_by);
+    }
+    r.text(body.landmarks_error);
+    if (!r.done()) return std::nullopt;
+    return body;
+}
+
+}  // namespace
+
+std::optional<BodyCacheKey> body_cache_key(const fs::path& character_file, const FitOptions& options) {
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) return std::nullopt;
+    const auto exe_size = fs::file_size(exe, ec);
+    if (ec) return std::nullopt;
+    const auto exe_time = mtime_ns(exe, ec);
+    if (ec) return std::nullopt;
+    const fs::path file = fs::absolute(character_file, ec).lexically_normal();
+    if (ec) return std::nullopt;
+    const auto bytes = read_all(file);
+    if (!bytes) return std::nullopt;
+
+    std::ostringstream key;
+    key << magic << "program " << exe.string() << ' ' << exe_size << ' ' << exe_time << '\n';
+    key << "file " << file.string() << ' ' << bytes->size() << ' ' << std::hash<std::string_view>{}(*bytes) << '\n';
+    // The files beside it (a .gltf's buffers, an .fbx's textures), by size and time.
+    std::vector<std::string> beside;
+    for (const fs::directory_entry& entry : fs::directory_iterator(file.parent_path(), ec)) {
+        std::error_code entry_ec;
+        if (!entry.is_regular_file(entry_ec) || entry.path() == file) continue;
+        const auto size = entry.file_size(entry_ec);
+        const auto time = mtime_ns(entry.path(), entry_ec);
+        if (entry_ec) return std::nullopt;
+        beside.push_back(entry.path().filename().string() + ' ' + std::to_string(size) + ' ' + std::to_string(time));
+    }
+    if (ec) return std::nullopt;
+    std::sort(beside.begin(), beside.end());
+    for (const std::string& b : beside) key << "beside " << b << '\n';
+    key << "options " << number(options.min_cluster_fraction) << ' ' << number(options.min_cluster_size) << ' '
+        << number(options.tolerance_m) << ' ' << number(options.bulge_limit_m) << ' ' << number(options.target_coverage) << ' '
+        << number(options.sample_spacing) << ' ' << number(options.min_radius_m) << ' ' << options.max_ellipsoids << ' '
+        << options.tight_extra_ellipsoids << ' ' << number(options.leg_reach_m) << ' ' << int(options.legs) << ' '
+        << number(options.knee_radius_share) << '\n';
+    const std::size_t threads = std::min(static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
+                                         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    key << "threads " << threads << '\n';
+
+    BodyCacheKey out;
+    out.text = key.str();
+    char name[32];
+    const auto [end, to_ec] = std::to_chars(name, name + sizeof name, std::hash<std::string_view>{}(out.text), 16);
+    out.name = file.stem().string() + '-' + std::string(name, to_ec == std::errc() ? end : name) + ".body";
+    return out;
+}
+
+std::optional<CharacterBody> read_cached_body(const fs::path& folder, const BodyCacheKey& key) {
+    const auto bytes = read_all(folder / key.name);
+    if (!bytes || bytes->size() < key.text.size() || std::string_view(*bytes).substr(0, key.text.size()) != key.text)
+        return std::nullopt;
+    return decode(std::string_view(*bytes).substr(key.text.size()));
+}
+
+bool write_cached_body(const fs::path& folder, const BodyCacheKey& key, const CharacterBody& body) {
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (ec) return false;
+    const fs::path target = folder / key.name;
+    const fs::path temporary = folder / (key.name + ".tmp" + std::to_string(::getpid()));
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out << key.text << encode(body);
+        if (!out.flush()) {
+            fs::remove(temporary, ec);
+            return false;
+        }
+    }
+    fs::rename(temporary, target, ec);
+    if (!ec) return true;
+    fs::remove(temporary, ec);
+    return false;
+}
+
+Result<CharacterBody> fit_character_body(const CharacterAsset& character, const fs::path& file, const FitOptions& options,
+                                         const fs::path& folder) {
+    std::optional<BodyCacheKey> key;
+    if (!folder.empty()) key = body_cache_key(file, options);
+    if (key) {
+        if (auto body = read_cached_body(folder, *key)) return std::move(*body);
+    }
+    auto body = fit_character_body(character, options);
+    if (body && key) (void)write_cached_body(folder, *key, *body);
+    return body;
+}
+
+fs::path body_cache_from_environment() {
+    const char* folder = std::getenv("DRAPE_BODY_CACHE");
+    return folder != nullptr ? fs::path(folder) : fs::path();
+}
+
+}  // namespace drape
