@@ -17,6 +17,7 @@
 #include <numbers>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -27,6 +28,7 @@
 #include "drape/systems/character/character_report.hpp"
 #include "drape/systems/character/pose.hpp"
 #include "tests/character/leg_expectations.hpp"
+#include "tests/figures.hpp"
 #include "tests/game/character_contract.hpp"
 #include "tests/test_paths.hpp"
 
@@ -463,11 +465,21 @@ std::vector<std::pair<std::string, AvatarModel>> unusual_builds() {
     return builds;
 }
 
+// Labelled `figures` (the fits stand at the 2 cm bulge target, where rounding decides): the
+// short form fits the first build once and asserts a usable body.
 TEST(AvatarBuilds, FittedEllipsoidsHugShortWideAndLongLeggedBodies) {
-    for (const auto& [name, model] : unusual_builds()) {
+    auto builds = unusual_builds();
+    for (const auto& [name, model] : test::cases(std::span(builds))) {
         const auto c = import_model(model, name);
         ASSERT_TRUE(c) << name << ": " << c.error().message;
-        expect_hugging_ellipsoids(**c, name);
+        if (test::full_form()) {
+            expect_hugging_ellipsoids(**c, name);
+            continue;
+        }
+        const auto body = fit_character_body(**c);
+        ASSERT_TRUE(body) << body.error().message;
+        ASSERT_FALSE(body->ellipsoids.empty());
+        for (const EllipsoidShape& e : body->ellipsoids) EXPECT_TRUE(e.radii_m.allFinite() && e.radii_m.minCoeff() > 0);
     }
 }
 
@@ -513,7 +525,8 @@ TEST(AvatarBuilds, AHemOverThinLegsGetsMoreLines) {
 // 36 lines: AHemOverThinLegsGetsMoreLines; 22.9 % with 27), dress 10.0 % on all
 // three (on the short build the dress is shortened to clear the ankles).
 TEST(AvatarBuilds, SkirtAndDressHoldTheContractOnTheUnusualBuilds) {
-    for (const auto& [name, model] : unusual_builds()) {
+    auto builds = unusual_builds();
+    for (const auto& [name, model] : test::cases(std::span(builds))) {
         for (const GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
             const std::string garment = type == GarmentType::skirt ? "skirt" : "dress";
             SCOPED_TRACE(name + ", " + garment);
@@ -524,10 +537,10 @@ TEST(AvatarBuilds, SkirtAndDressHoldTheContractOnTheUnusualBuilds) {
             scene.garments.at(0).type = type;
             auto world = build_world(scene, {});
             ASSERT_TRUE(world) << world.error().message;
-            for (int frame = 0; frame < 600; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+            for (int frame = 0; frame < test::frames(600); ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
             const GarmentStats g = run_stats(*world).garments.at(0);
             test::expect_character_contract(g);
-            EXPECT_GT(g.penetration_before_response_m, 1e-3) << "the body must have pushed the garment";
+            if (test::full_form()) EXPECT_GT(g.penetration_before_response_m, 1e-3) << "the body must have pushed the garment";
         }
     }
 }
