@@ -44,11 +44,31 @@ drape_install_packages() {
   "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
-# Configures (once) and builds incrementally in $DRAPE_BUILD_DIR, Release.
+# Runs a command and prints how long it took: `drape_timed WHAT command...`.
+drape_timed() {
+  local what=$1 start rc=0
+  shift
+  start=$(date +%s)
+  "$@" || rc=$?
+  drape_log "$what: $(( $(date +%s) - start )) s"
+  return "$rc"
+}
+
+# Configures (once) and builds incrementally in $DRAPE_BUILD_DIR, Release. With ccache
+# installed it is the compiler launcher, its base directory the checkout, so that a clone
+# in another folder is served from the same cache. ccache takes -march=native as written,
+# not as the CPU it means: the compiler's target options for this CPU are its compiler
+# check, so that another CPU does not get this one's objects.
 drape_build() {
   local extra=(${DRAPE_CMAKE_ARGS:-})
-  if [ ! -f "$DRAPE_BUILD_DIR/CMakeCache.txt" ] || [ ${#extra[@]} -gt 0 ]; then
-    cmake -S "$DRAPE_ROOT" -B "$DRAPE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${extra[@]}" "$@" >/dev/null
+  local launcher=()
+  if command -v ccache >/dev/null 2>&1; then
+    export CCACHE_BASEDIR="$DRAPE_ROOT"
+    export CCACHE_COMPILERCHECK="%compiler% -march=native -Q --help=target"
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   fi
-  cmake --build "$DRAPE_BUILD_DIR" --parallel "$(nproc)"
+  if [ ! -f "$DRAPE_BUILD_DIR/CMakeCache.txt" ] || [ ${#extra[@]} -gt 0 ]; then
+    cmake -S "$DRAPE_ROOT" -B "$DRAPE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${extra[@]}" "$@" >/dev/null
+  fi
+  drape_timed "build ($DRAPE_BUILD_DIR)" cmake --build "$DRAPE_BUILD_DIR" --parallel "$(nproc)"
 }
