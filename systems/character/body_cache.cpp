@@ -36,7 +36,7 @@ static_assert(sizeof(BodySection) == 40, "body_cache.cpp: write and read the new
 static_assert(sizeof(BodyLandmarks) == 408, "body_cache.cpp: write and read the new BodyLandmarks field");
 static_assert(sizeof(CharacterBody) == 480, "body_cache.cpp: write and read the new CharacterBody field");
 constexpr std::string_view magic = "drape fitted body 1\n";
-constexpr std::size_t encoded_ellipsoid_bytes = 4 + 12 + 16 + 12 + 1 + 4;  // as encode() writes one
+constexpr std::size_t encoded_ellipsoid_bytes = 4 + 12 + 16 + 12 + 1 + 4;  // as body_fields() lists one
 
 std::string number(double v) {
     char buffer[64];
@@ -57,181 +57,153 @@ std::optional<std::string> read_all(const fs::path& p) {
     return bytes;
 }
 
-// Little helpers to write and read the body's fields in a fixed order.
+// Writes the fields body_fields() lists.
 class Writer {
 public:
     template <class T>
     void raw(const T& v) {
         static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
-        const char* p = reinterpret_cast<const char*>(&v);
-        out.append(p, sizeof v);
+        out.append(reinterpret_cast<const char*>(&v), sizeof v);
     }
-    void vec(const Vec3& v) { for (int i = 0; i < 3; ++i) raw(v[i]); }
-    void ints(const std::vector<int>& v) {
+    template <class V, class F>
+    void items(const V& v, std::size_t /*item_bytes*/, F&& each) {
         raw(static_cast<std::uint32_t>(v.size()));
-        for (int i : v) raw(i);
+        for (const auto& item : v) each(item);
+    }
+    template <class O, class F>
+    void maybe(const O& o, F&& each) {
+        raw(static_cast<std::uint8_t>(o.has_value()));
+        if (o) each(*o);
     }
     void text(const std::string& s) {
         raw(static_cast<std::uint32_t>(s.size()));
         out += s;
     }
-    void point(const BodyPoint& p) {
-        raw(p.bone);
-        vec(p.rest_m);
-        vec(p.local_m);
-    }
-    void section(const BodySection& s) {
-        point(s.center);
-        raw(s.half_width_m);
-        raw(s.half_depth_m);
-        raw(s.girth_m);
-    }
-    void limb(const LimbChain& c) {
-        raw(c.root);
-        raw(c.middle);
-        raw(c.end);
-    }
     std::string out;
 };
 
+// Reads them back; a file too short or too long for them is not a body.
 class Reader {
 public:
     explicit Reader(std::string_view in) : m_in(in) {}
     template <class T>
     void raw(T& v) {
         static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+        v = T{};
         if (m_in.size() < sizeof v) {
-            ok = false;
-            v = T{};
+            m_ok = false;
             return;
         }
         std::memcpy(&v, m_in.data(), sizeof v);
         m_in.remove_prefix(sizeof v);
     }
-    void vec(Vec3& v) { for (int i = 0; i < 3; ++i) raw(v[i]); }
-    std::uint32_t count(std::size_t item_bytes) {
-        std::uint32_t n = 0;
-        raw(n);
-        if (std::size_t(n) * item_bytes > m_in.size()) {
-            ok = false;
-            return 0;
-        }
-        return n;
+    template <class V, class F>
+    void items(V& v, std::size_t item_bytes, F&& each) {
+        v.resize(count(item_bytes));
+        for (auto& item : v) each(item);
     }
-    void ints(std::vector<int>& v) {
-        v.resize(count(sizeof(int)));
-        for (int& i : v) raw(i);
+    template <class O, class F>
+    void maybe(O& o, F&& each) {
+        std::uint8_t present = 0;
+        raw(present);
+        if (present) each(o.emplace());
     }
     void text(std::string& s) {
         const std::uint32_t n = count(1);
         s.assign(m_in.substr(0, n));
         m_in.remove_prefix(n);
     }
-    void point(BodyPoint& p) {
-        raw(p.bone);
-        vec(p.rest_m);
-        vec(p.local_m);
-    }
-    void section(BodySection& s) {
-        point(s.center);
-        raw(s.half_width_m);
-        raw(s.half_depth_m);
-        raw(s.girth_m);
-    }
-    void limb(LimbChain& c) {
-        raw(c.root);
-        raw(c.middle);
-        raw(c.end);
-    }
-    [[nodiscard]] bool done() const { return ok && m_in.empty(); }
-    bool ok = true;
+    [[nodiscard]] bool done() const { return m_ok && m_in.empty(); }
 
 private:
+    std::uint32_t count(std::size_t item_bytes) {
+        std::uint32_t n = 0;
+        raw(n);
+        if (std::size_t(n) * item_bytes > m_in.size()) {
+            m_ok = false;
+            return 0;
+        }
+        return n;
+    }
     std::string_view m_in;
+    bool m_ok = true;
 };
+
+template <class Io, class V>
+void vec3(Io& io, V& v) {
+    for (int i = 0; i < 3; ++i) io.raw(v[i]);
+}
+
+template <class Io, class P>
+void point(Io& io, P& p) {
+    io.raw(p.bone);
+    vec3(io, p.rest_m);
+    vec3(io, p.local_m);
+}
+
+template <class Io, class S>
+void section(Io& io, S& s) {
+    point(io, s.center);
+    io.raw(s.half_width_m);
+    io.raw(s.half_depth_m);
+    io.raw(s.girth_m);
+}
+
+// A body's fields in the file's order, one list for writing and reading (Body is
+// CharacterBody or const CharacterBody): a number or an enum as its bytes, a vector or a
+// string as its size and its items, an optional as a flag and its value.
+template <class Io, class Body>
+void body_fields(Io& io, Body& body) {
+    io.items(body.ellipsoids, encoded_ellipsoid_bytes, [&](auto& s) {
+        io.raw(s.bone);
+        vec3(io, s.center);
+        for (int i = 0; i < 4; ++i) io.raw(s.rotation.coeffs()[i]);
+        vec3(io, s.radii_m);
+        io.raw(s.region);
+        io.raw(s.give_m);
+    });
+    io.raw(body.hip_bone);
+    io.raw(body.legs);
+    io.maybe(body.landmarks, [&](auto& l) {
+        vec3(io, l.up);
+        vec3(io, l.forward);
+        vec3(io, l.left);
+        io.raw(l.floor_m);
+        io.raw(l.top_m);
+        io.raw(l.height_m);
+        io.raw(l.pelvis_bone);
+        io.items(l.spine, sizeof(int), [&](auto& bone) { io.raw(bone); });
+        io.raw(l.chest_bone);
+        io.raw(l.head_bone);
+        for (auto* c : {&l.left_leg, &l.right_leg, &l.left_arm, &l.right_arm}) {
+            io.raw(c->root);
+            io.raw(c->middle);
+            io.raw(c->end);
+        }
+        io.items(l.body_bones, sizeof(int), [&](auto& bone) { io.raw(bone); });
+        io.raw(l.crotch_m);
+        io.raw(l.underarm_m);
+        point(io, l.under_arms);
+        section(io, l.waist);
+        section(io, l.hips);
+        section(io, l.chest);
+        point(io, l.left_shoulder);
+        point(io, l.right_shoulder);
+        io.text(l.found_by);
+    });
+    io.text(body.landmarks_error);
+}
 
 std::string encode(const CharacterBody& body) {
     Writer w;
-    w.raw(static_cast<std::uint32_t>(body.ellipsoids.size()));
-    for (const EllipsoidShape& s : body.ellipsoids) {
-        w.raw(s.bone);
-        w.vec(s.center);
-        for (int i = 0; i < 4; ++i) w.raw(s.rotation.coeffs()[i]);
-        w.vec(s.radii_m);
-        w.raw(s.region);
-        w.raw(s.give_m);
-    }
-    w.raw(body.hip_bone);
-    w.raw(body.legs);
-    w.raw(static_cast<std::uint8_t>(body.landmarks.has_value()));
-    if (const auto& l = body.landmarks) {
-        w.vec(l->up);
-        w.vec(l->forward);
-        w.vec(l->left);
-        w.raw(l->floor_m);
-        w.raw(l->top_m);
-        w.raw(l->height_m);
-        w.raw(l->pelvis_bone);
-        w.ints(l->spine);
-        w.raw(l->chest_bone);
-        w.raw(l->head_bone);
-        for (const LimbChain* c : {&l->left_leg, &l->right_leg, &l->left_arm, &l->right_arm}) w.limb(*c);
-        w.ints(l->body_bones);
-        w.raw(l->crotch_m);
-        w.raw(l->underarm_m);
-        w.point(l->under_arms);
-        w.section(l->waist);
-        w.section(l->hips);
-        w.section(l->chest);
-        w.point(l->left_shoulder);
-        w.point(l->right_shoulder);
-        w.text(l->found_by);
-    }
-    w.text(body.landmarks_error);
+    body_fields(w, body);
     return w.out;
 }
 
 std::optional<CharacterBody> decode(std::string_view bytes) {
     Reader r(bytes);
     CharacterBody body;
-    body.ellipsoids.resize(r.count(encoded_ellipsoid_bytes));
-    for (EllipsoidShape& s : body.ellipsoids) {
-        r.raw(s.bone);
-        r.vec(s.center);
-        for (int i = 0; i < 4; ++i) r.raw(s.rotation.coeffs()[i]);
-        r.vec(s.radii_m);
-        r.raw(s.region);
-        r.raw(s.give_m);
-    }
-    r.raw(body.hip_bone);
-    r.raw(body.legs);
-    std::uint8_t has_landmarks = 0;
-    r.raw(has_landmarks);
-    if (has_landmarks) {
-        BodyLandmarks& l = body.landmarks.emplace();
-        r.vec(l.up);
-        r.vec(l.forward);
-        r.vec(l.left);
-        r.raw(l.floor_m);
-        r.raw(l.top_m);
-        r.raw(l.height_m);
-        r.raw(l.pelvis_bone);
-        r.ints(l.spine);
-        r.raw(l.chest_bone);
-        r.raw(l.head_bone);
-        for (LimbChain* c : {&l.left_leg, &l.right_leg, &l.left_arm, &l.right_arm}) r.limb(*c);
-        r.ints(l.body_bones);
-        r.raw(l.crotch_m);
-        r.raw(l.underarm_m);
-        r.point(l.under_arms);
-        r.section(l.waist);
-        r.section(l.hips);
-        r.section(l.chest);
-        r.point(l.left_shoulder);
-        r.point(l.right_shoulder);
-        r.text(l.found_by);
-    }
-    r.text(body.landmarks_error);
+    body_fields(r, body);
     if (!r.done()) return std::nullopt;
     return body;
 }

@@ -88,7 +88,7 @@ TEST(BodyCache, AWorldFromTheCacheIsTheWorldAFitGivesAndTheCacheIsWhatItReads) {
 
     // The second world read the file: a radius changed in it reaches the world. The first
     // shape's first radius is the float after the key text and the shape's bone, centre
-    // and rotation (body_cache.cpp's encode).
+    // and rotation (body_cache.cpp's body_fields).
     const std::string original = read(files[0]);
     const auto key = body_cache_key(sample_scene().characters.at(0).file, FitOptions{});
     ASSERT_TRUE(key);
