@@ -12,10 +12,10 @@
 #include "drape/components/skeleton.hpp"
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/character_import.hpp"
-#include "drape/systems/character/body_cache.hpp"
 #include "drape/game/collider_overrides.hpp"
 #include "drape/game/scene_file.hpp"
 #include "drape/game/scene_garment_parameters.hpp"
+#include "drape/systems/character/body_cache.hpp"
 #include "drape/systems/character/character_body.hpp"
 #include "drape/systems/character_systems.hpp"
 #include "drape/systems/character/spawn.hpp"
@@ -38,7 +38,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
-
 
 }  // namespace
 
