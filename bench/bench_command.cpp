@@ -26,6 +26,8 @@ const std::vector<Benchmark>& benchmarks() {
         {"render", "off-screen rendering at 1280x720, ms per frame", run_render},
         {"soak", "the sample scene walking for an hour of simulated time: drift per minute", run_soak},
         {"quality", "after-frame strain, penetration, cost and shape against a converged reference, per garment x model x character", run_quality},
+        {"motions", "every character x each clip a garment is played on and root motions x garment x model x start, judged by the contract", run_motions},
+        {"garments", "garments from files (four cut garments) on every character's walk and run, judged by the contract, cost per particle", run_garments},
     };
     return list;
 }
@@ -39,6 +41,7 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     if (o.out_dir != "docs/reports") c += " --out " + o.out_dir.string();
     if (runs_set) c += " --runs " + std::to_string(runs);
     if (threads_set) c += " --threads " + std::to_string(threads);
+    if (!o.filter.empty()) c += " --filter '" + o.filter + "'";
     return c;
 }
 
@@ -72,6 +75,7 @@ void add_bench_command(CLI::App& app) {
         int runs = 5;
         int threads = 1;
         bool overwrite = false;
+        std::string filter;
     };
     auto cli = std::make_shared<Cli>();
     std::string names;
@@ -84,6 +88,7 @@ void add_bench_command(CLI::App& app) {
     command->add_option("--out", cli->out, "Folder for the Markdown reports and plots (default docs/reports)");
     command->add_option("--runs", cli->runs, "Repeated runs; tables show medians (default 5)")->check(CLI::Range(1, 1000));
     command->add_option("--threads", cli->threads, "Worker threads for parallel systems (default 1)")->check(CLI::Range(1, 256));
+    command->add_option("--filter", cli->filter, "Only the cases whose name holds every comma-separated word (motions)");
     command->add_flag("--overwrite", cli->overwrite, "Replace an existing --json file or a NAME.md this command did not write");
     command->footer("Benchmarks: " + names + ". Each writes NAME.md and NAME*.png in the output folder "
                     "and never asserts a timing; it fails only when it cannot run.");
@@ -114,6 +119,7 @@ void add_bench_command(CLI::App& app) {
             options.out_dir = cli->out;
             options.runs = cli->runs;
             options.threads = cli->threads;
+            options.filter = cli->filter;
             if (!cli->json.empty())
                 options.json = cli->name == "all" ? std::filesystem::path(cli->json) / (b->name + ".json")
                                                   : std::filesystem::path(cli->json);

@@ -40,6 +40,7 @@ struct SweepRow {
     int substeps;   ///< 0 = automatic.
     int iterations;
     CollisionMode collision;
+    ClothIntegrator integrator = ClothIntegrator::shipped;
     double ms_per_frame = 0, rms_error_m = 0;
     double strain_max = 0, strain_p99 = 0, penetration_after_m = 0;
     double mean_substeps = 0;
@@ -48,9 +49,11 @@ struct SweepRow {
 const char* model_name(ClothModel m) { return m == ClothModel::simplified ? "simplified" : "classic"; }
 const char* collision_name(CollisionMode c) { return c == CollisionMode::candidate_lists ? "lists" : "brute_force"; }
 
-Result<World> sweep_world(ClothModel model, int substeps, int iterations, CollisionMode collision, int threads) {
+Result<World> sweep_world(ClothModel model, int substeps, int iterations, CollisionMode collision, int threads,
+                          ClothIntegrator integrator = ClothIntegrator::shipped) {
     WorldSpec spec;
     spec.model = model;
+    spec.integrator = integrator;
     spec.collision = collision;
     spec.substeps = substeps;
     spec.threads = threads;
@@ -65,7 +68,7 @@ Result<World> sweep_world(ClothModel model, int substeps, int iterations, Collis
 /// Distance from the reference over its horizons, with the time and after-frame quality of
 /// every frame from the first horizon on.
 Result<SweepRow> measure(SweepRow row, const HorizonPlan& plan, const ConvergedReference& reference, int threads) {
-    auto world = sweep_world(row.model, row.substeps, row.iterations, row.collision, threads);
+    auto world = sweep_world(row.model, row.substeps, row.iterations, row.collision, threads, row.integrator);
     if (!world) return fail(world.error().message);
     std::vector<double> frame_ms;
     StrainHistogram strains;
@@ -313,6 +316,16 @@ Result<void> run_error(const BenchOptions& options) {
                     if (!row) return fail("error: " + row.error().message);
                     rows.push_back(*row);
                 }
+    // The paper's integrator (docs/cloth.md "Two integrators"): with its own substeps (its
+    // stability bound; fewer diverge) and with twice as many, both models, the default rounds.
+    for (ClothModel model : {ClothModel::simplified, ClothModel::classic})
+        for (int substeps : {0, 256}) {
+            SweepRow paper_row{model, substeps, ClothMaterial{}.iterations, CollisionMode::candidate_lists};
+            paper_row.integrator = ClothIntegrator::paper;
+            auto row = measure(paper_row, plan, *reference, options.threads);
+            if (!row) return fail("error: " + row.error().message);
+            rows.push_back(*row);
+        }
     const GarmentDescription shipped;
     const int default_iterations = ClothMaterial{}.iterations;
     auto default_row = measure({shipped.model, 0, default_iterations, shipped.collision}, plan, *reference, options.threads);
@@ -355,7 +368,8 @@ Result<void> run_error(const BenchOptions& options) {
     if (!sheet_rows) return fail("error: " + sheet_rows.error().message);
 
     auto to_json = [](const SweepRow& r) {
-        return nlohmann::json{{"model", model_name(r.model)},
+        return nlohmann::json{{"integrator", cloth_integrator_name(r.integrator)},
+                              {"model", model_name(r.model)},
                               {"substeps", r.substeps == 0 ? nlohmann::json("auto") : nlohmann::json(r.substeps)},
                               {"iterations", r.iterations},
                               {"collision", collision_name(r.collision)},
@@ -389,7 +403,10 @@ Result<void> run_error(const BenchOptions& options) {
         "default material (" + std::to_string(ClothMaterial{}.iterations) + " constraint rounds per substep) at " +
         std::to_string(reference->substeps) + " fixed substeps per 1/60 s frame, the step chosen by its own convergence "
         "(below). The error of a configuration is what its shortcuts cost (fewer springs, coarser steps, fewer "
-        "rounds, candidate lists). " + horizon_plan_text(plan) +
+        "rounds, candidate lists). Beside the shipped solver's sweep, the paper's integrator as written (docs/cloth.md "
+        "\"Two integrators\": explicit springs, Provot after the step) with its own substeps (auto: its stability "
+        "bound; fewer diverge) and at 256, candidate lists, the default rounds, both models, against the same "
+        "reference. " + horizon_plan_text(plan) +
         " ms per frame: the garment's simulation phase (frame profiler), one run per configuration, the median frame "
         "from the first horizon on. Strain (max, p99) and penetration after the frame are measured after every frame "
         "from the first horizon on, as `drape play --stats` measures them: strain of every structural spring with a "
@@ -420,16 +437,17 @@ Result<void> run_error(const BenchOptions& options) {
     std::vector<std::vector<std::string>> table;
     for (std::size_t i = 0; i < rows.size(); ++i) {
         const auto& r = rows[i];
-        const bool is_reference = r.model == ClothModel::classic && r.collision == CollisionMode::brute_force &&
+        const bool is_reference = r.integrator == ClothIntegrator::shipped && r.model == ClothModel::classic &&
+                                  r.collision == CollisionMode::brute_force &&
                                   r.substeps == reference->substeps && r.iterations == ClothMaterial{}.iterations;
-        table.push_back({std::string(model_name(r.model)) + (i == default_index ? " (default)" : "") +
+        table.push_back({cloth_integrator_name(r.integrator), std::string(model_name(r.model)) + (i == default_index ? " (default)" : "") +
                              (is_reference ? " (the reference's settings)" : ""),
                          r.substeps == 0 ? "auto (" + fixed(r.mean_substeps, 2) + ")" : std::to_string(r.substeps),
                          std::to_string(r.iterations), collision_name(r.collision), fixed(r.ms_per_frame, 4),
                          fixed(1000 * r.rms_error_m, 2), fixed(100 * r.strain_max, 1), fixed(100 * r.strain_p99, 1),
                          fixed(1000 * r.penetration_after_m, 2), pareto[i] ? "yes" : ""});
     }
-    report.table({"model", "substeps", "rounds", "collision", "ms / frame", "RMS error (mm)", "strain max (%)",
+    report.table({"integrator", "model", "substeps", "rounds", "collision", "ms / frame", "RMS error (mm)", "strain max (%)",
                   "strain p99 (%)", "penetration after (mm)", "Pareto"},
                  table);
     // How each model's error follows the step (candidate lists, the default rounds).
@@ -438,7 +456,9 @@ Result<void> run_error(const BenchOptions& options) {
         std::string figures, steps;
         for (std::size_t i = 0; i < default_index; ++i) {
             const auto& r = rows[i];
-            if (r.model != model || r.collision != CollisionMode::candidate_lists || r.iterations != default_iterations) continue;
+            if (r.integrator != ClothIntegrator::shipped || r.model != model || r.collision != CollisionMode::candidate_lists ||
+                r.iterations != default_iterations)
+                continue;
             figures += (figures.empty() ? "" : " -> ") + fixed(1000 * r.rms_error_m, 2);
             steps += (steps.empty() ? "" : ", ") + std::to_string(r.substeps);
         }
@@ -454,11 +474,16 @@ Result<void> run_error(const BenchOptions& options) {
         PlotData d{series_names[s], {}};
         for (std::size_t i = 0; i < default_index; ++i) {
             const auto& r = rows[i];
-            if ((r.model == ClothModel::classic) == (s >= 2) && (r.collision == CollisionMode::brute_force) == (s % 2 == 1))
+            if (r.integrator == ClothIntegrator::shipped && (r.model == ClothModel::classic) == (s >= 2) &&
+                (r.collision == CollisionMode::brute_force) == (s % 2 == 1))
                 d.rows.push_back({r.ms_per_frame, 1000 * r.rms_error_m});
         }
         data.push_back(d);
     }
+    PlotData paper_points{"paper", {}};
+    for (std::size_t i = 0; i < default_index; ++i)
+        if (rows[i].integrator == ClothIntegrator::paper) paper_points.rows.push_back({rows[i].ms_per_frame, 1000 * rows[i].rms_error_m});
+    data.push_back(paper_points);
     PlotData front{"front", {}};
     for (auto i : order)
         if (pareto[i]) front.rows.push_back({rows[i].ms_per_frame, 1000 * rows[i].rms_error_m});
@@ -473,6 +498,7 @@ Result<void> run_error(const BenchOptions& options) {
         "$sb using 1:2 with points pt 5 lc rgb '#60a0e0' title 'simplified + brute force', "
         "$cl using 1:2 with points pt 9 lc rgb '#c04030' title 'classic + lists', "
         "$cb using 1:2 with points pt 11 lc rgb '#e09060' title 'classic + brute force', "
+        "$paper using 1:2 with points pt 13 ps 1.5 lc rgb '#8040a0' title \"paper's integrator\", "
         "$front using 1:2 with steps lw 2 lc rgb '#202020' title 'Pareto front', "
         "$def using 1:2 with points pt 3 ps 3 lw 2 lc rgb '#10a010' title 'default (auto substeps)'" +
         (std::isfinite(reference->converged_m) ? ", " + fixed(1000 * reference->converged_m, 4) +

@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "bench/contact_sheet.hpp"
 #include "bench/probe.hpp"
 #include "bench/reference.hpp"
 #include "bench/report.hpp"
@@ -125,13 +126,7 @@ std::vector<CharacterCase> characters(std::vector<std::string>& missing) {
     avatar.file = default_avatar_path();
     avatar.default_avatar = true;
     list.push_back(avatar);
-    // The shared third-party characters sit next to the project: ../shared/assets from the
-    // source tree's root (or from the working folder when the source tree is gone).
-    fs::path shared = fs::path("..") / "shared" / "assets" / "characters";
-#ifdef DRAPE_BENCH_SOURCE_DIR
-    if (std::error_code ec; fs::is_directory(fs::path(DRAPE_BENCH_SOURCE_DIR) / shared, ec))
-        shared = (fs::path(DRAPE_BENCH_SOURCE_DIR) / shared).lexically_normal();
-#endif
+    const fs::path shared = shared_characters_dir();
     const std::pair<const char*, const char*> files[] = {
         {"Male_Casual", "male_casual/Male_Casual.fbx"},
         {"Female_Alternative", "female_alternative/Female_Alternative.fbx"},
@@ -267,23 +262,6 @@ Result<void> measure_springs(SpringsRow& row, const CharacterCase& c, const Conv
 // --- Contact sheet ---------------------------------------------------------------------
 
 #ifdef DRAPE_HAVE_RENDER
-/// Averages `scale` x `scale` blocks of `source` into the tile at (x0, y0) of `sheet` (what
-/// would fall outside the sheet is left out).
-void put_tile(Image& sheet, const Image& source, int x0, int y0, int scale) {
-    const int height = std::min(source.height / scale, sheet.height - y0);
-    const int width = std::min(source.width / scale, sheet.width - x0);
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x)
-            for (int channel = 0; channel < 4; ++channel) {
-                int sum = 0;
-                for (int dy = 0; dy < scale; ++dy)
-                    for (int dx = 0; dx < scale; ++dx) sum += source.at(x * scale + dx, y * scale + dy)[channel];
-                const std::size_t at = (static_cast<std::size_t>(y0 + y) * static_cast<std::size_t>(sheet.width) +
-                                        static_cast<std::size_t>(x0 + x)) * 4 + static_cast<std::size_t>(channel);
-                sheet.rgba[at] = static_cast<std::uint8_t>((sum + scale * scale / 2) / (scale * scale));
-            }
-}
-
 /// Renders one case's walk cycle into row `row` of `sheet`.
 Result<void> render_row(Image& sheet, int row, const CharacterCase& c, GarmentType garment, ClothModel model,
                         int threads) {
@@ -322,11 +300,7 @@ Result<void> render_row(Image& sheet, int row, const CharacterCase& c, GarmentTy
 std::string contact_sheet(const BenchOptions& options, GarmentType garment, const std::vector<CharacterCase>& cases,
                           const std::string& png_name) {
 #ifdef DRAPE_HAVE_RENDER
-    Image sheet;
-    const int rows = static_cast<int>(cases.size()) * 2;
-    sheet.width = sheet_phases * (tile_width + 4) - 4;
-    sheet.height = rows * (tile_height + 4) - 4;
-    sheet.rgba.assign(static_cast<std::size_t>(sheet.width) * static_cast<std::size_t>(sheet.height) * 4, 255);
+    Image sheet = blank_sheet(sheet_phases, static_cast<int>(cases.size()) * 2, tile_width, tile_height);
     int row = 0;
     for (const CharacterCase& c : cases)
         for (ClothModel model : {ClothModel::simplified, ClothModel::classic}) {
@@ -581,8 +555,9 @@ Result<void> run_quality(const BenchOptions& options) {
         "pinned particle inside one, the highest free particle above the highest pin, non-finite values and resets; "
         "over " + std::to_string(cases.front().stats_frames) + " frames on the default avatar and " +
         std::to_string(cases.size() > 1 ? cases[1].stats_frames : cases.front().stats_frames) +
-        " on the other characters (fewer, to keep the benchmark within minutes). The run starts from the garment's "
-        "rest shape, so its first frames count too. **ms / frame**: the garment's simulation phase (frame profiler), "
+        " on the other characters (fewer, to keep the benchmark within minutes). The garment is put on first, "
+        "settled on the body held in the clip's first pose (solver.settle_s, docs/characters.md); every frame of the "
+        "run counts. **ms / frame**: the garment's simulation phase (frame profiler), "
         "the median frame of the run, one thread, median over runs. \"default\" in the JSON marks the shipped "
         "model (" + std::string(short_name(GarmentDescription{}.model)) + ").");
     report.paragraph(

@@ -27,6 +27,7 @@ struct BenchOptions {
     int runs = 5;                              ///< Repeated runs; tables show medians.
     int threads = 1;                           ///< Worker threads (tbb::global_control).
     std::string command;                       ///< The command line that reproduces the run.
+    std::string filter;                        ///< Comma-separated words a case's name must hold (benchmarks that list cases).
 };
 
 /// The machine and conditions a report was measured under.
@@ -132,5 +133,7 @@ struct Benchmark {
 [[nodiscard]] Result<void> run_render(const BenchOptions& options);
 [[nodiscard]] Result<void> run_soak(const BenchOptions& options);
 [[nodiscard]] Result<void> run_quality(const BenchOptions& options);
+[[nodiscard]] Result<void> run_motions(const BenchOptions& options);
+[[nodiscard]] Result<void> run_garments(const BenchOptions& options);
 
 }  // namespace drape::bench

@@ -62,7 +62,4 @@ struct Divergence {
 
 [[nodiscard]] Divergence classify_divergence(const RunTrace& trace, const DivergenceLimits& limits);
 
-/// Kinetic energy of particles with masses 1 / inv_mass (pinned ones, inv_mass 0, left out), J.
-[[nodiscard]] double kinetic_energy_J(const Matrix3X& v, const VectorX& inv_mass);
-
 }  // namespace drape::bench

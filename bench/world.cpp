@@ -26,6 +26,7 @@ SceneDescription scene_for(const WorldSpec& spec) {
         g.type = spec.garment;
         g.character = i;
         g.model = spec.model;
+        g.integrator = spec.integrator;
         g.collision = spec.collision;
         if (spec.particles > 0) g.parameters.push_back({"particles", static_cast<double>(spec.particles)});
         scene.garments.push_back(g);
@@ -48,6 +49,16 @@ Result<World> build_bench_world(const WorldSpec& spec) {
     options.profile = spec.profile;
     options.render = spec.render;
     return build_world(scene, options);
+}
+
+std::filesystem::path shared_characters_dir() {
+    namespace fs = std::filesystem;
+    fs::path shared = fs::path("..") / "shared" / "assets" / "characters";
+#ifdef DRAPE_BENCH_SOURCE_DIR
+    if (std::error_code ec; fs::is_directory(fs::path(DRAPE_BENCH_SOURCE_DIR) / shared, ec))
+        shared = (fs::path(DRAPE_BENCH_SOURCE_DIR) / shared).lexically_normal();
+#endif
+    return shared;
 }
 
 Garment& first_garment(World& world) { return world.registry.get<Garment>(world.garments.at(0)); }

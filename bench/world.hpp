@@ -2,6 +2,7 @@
 // through the game's scene description exactly as `drape play` builds its scene.
 #pragma once
 
+#include <filesystem>
 #include <vector>
 
 #include "drape/components/garment.hpp"
@@ -15,6 +16,7 @@ struct WorldSpec {
     int walkers = 1;                                   ///< Characters, in a grid 1.5 m apart.
     GarmentType garment = GarmentType::skirt;
     ClothModel model = ClothModel::simplified;
+    ClothIntegrator integrator = ClothIntegrator::shipped;
     CollisionMode collision = CollisionMode::candidate_lists;
     int particles = 0;                                 ///< 0: the builder's default.
     int substeps = 0;                                  ///< 0: the cloth's stability rule.
@@ -32,6 +34,10 @@ struct WorldSpec {
 
 /// Builds a headless world; the error says what is missing (e.g. the avatar file).
 [[nodiscard]] Result<World> build_bench_world(const WorldSpec& spec);
+
+/// The shared third-party characters next to the project: ../shared/assets/characters from
+/// the source tree's root (or from the working folder when the source tree is gone).
+[[nodiscard]] std::filesystem::path shared_characters_dir();
 
 /// The first garment of a world.
 [[nodiscard]] Garment& first_garment(World& world);

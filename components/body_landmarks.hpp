@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drape/engine/core/math.hpp"
@@ -59,6 +60,8 @@ struct BodyLandmarks {
     BodySection chest;             ///< Widest torso section between waist and underarm.
     BodyPoint left_shoulder, right_shoulder;  ///< Shoulder joints.
     std::string found_by;          ///< "bone names" or "topology": how the pelvis was found.
+    /// How each landmark was found, in the order `drape inspect` prints them: {landmark, how}.
+    std::vector<std::pair<std::string, std::string>> how_found;
 };
 
 }  // namespace drape

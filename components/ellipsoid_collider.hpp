@@ -66,6 +66,7 @@ struct EllipsoidCollider {
     Vec3 acceleration_m_s2 = Vec3::Zero();         ///< Of the centre.
     Vec3 angular_velocity_rad_s = Vec3::Zero();    ///< Of the ellipsoid frame.
     bool initialised = false;                      ///< False until the first update (no velocity yet).
+    bool placed = false;                           ///< `world` holds the bone's pose: set by spawn_character and every update.
     Quat world_rotation = Quat::Identity();        ///< Rotation part of `world` (ellipsoid axes in world space).
     std::uint8_t updates = 0;                      ///< Updates so far, saturating at 2: velocity needs 1, acceleration 2.
 };

@@ -43,6 +43,16 @@ enum class ClothModel : std::uint8_t {
     classic,     ///< Provot's: stretch, shear and bend springs, every particle integrated.
 };
 
+/// Which scheme steps the garment through a substep (docs/cloth.md "Two integrators").
+enum class ClothIntegrator : std::uint8_t {
+    shipped,  ///< Eq. 2 without its spring term, the springs as compliant constraints, the limits
+              ///< and contact repair (docs/cloth.md "Solver"): stable at any stiffness and step.
+    paper,    ///< The paper's as written: eq. 2 with its spring forces, explicit (method §3.3-§3.4),
+              ///< layer 2 placed from layer 1 (§3.2), Provot's limit after the step (§4.1), then
+              ///< each particle out of the ellipsoids with its normal velocity removed (§5);
+              ///< substeps from its stability bound.
+};
+
 /// How particles find the ellipsoids they touch (method §5).
 enum class CollisionMode : std::uint8_t {
     candidate_lists,  ///< Per-particle candidate lists + last-collided first.
@@ -71,6 +81,8 @@ struct Fabric {
     std::vector<std::uint32_t> grid;        ///< Particle index of (line, row): grid[line * m + row].
     std::vector<std::uint8_t> layer;        ///< 1 or 2 per particle.
     VectorX area_m2;                        ///< Per particle: the rest area it stands for (a quarter of each quad around it).
+    Matrix3X rest_shape;                    ///< The cut: the positions the rest lengths and areas were measured on, grid order
+                                            ///< (column line * m + row), in the world where the garment was built.
     std::vector<std::uint32_t> triangles;   ///< Render triangles over the particle grid.
 
     // Structural springs (method §3.2, §4.1), both models.
@@ -102,6 +114,7 @@ struct ClothMaterial {
     Real drag_N_s_m3 = Real(0.3);           ///< Air drag per area per speed (method §3.3 k = this x particle area).
     Real friction = Real(0.4);              ///< Coulomb coefficient of the cloth on the body.
     Real strain_limit = Real(0.10);         ///< Provot: max relative over-stretch (method §4.1).
+    Real compression_limit = Real(0.25);    ///< Shortest a spring may be, over its rest length (0: none).
     int iterations = 4;                     ///< Constraint rounds per substep.
     Real candidate_margin_m = Real(0.08);   ///< Candidate lists: reach beyond the surface (method §5).
     friend bool operator==(const ClothMaterial&, const ClothMaterial&) = default;
@@ -120,6 +133,7 @@ struct InertiaScales {
 /// systems/cloth/garment_config.hpp so that the solver's caches follow.
 struct GarmentConfig {
     ClothModel model = ClothModel::simplified;
+    ClothIntegrator integrator = ClothIntegrator::shipped;
     CollisionMode collision = CollisionMode::candidate_lists;
     ClothMaterial material;
     InertiaScales inertia;
@@ -176,6 +190,8 @@ struct GarmentCounters {
     std::uint64_t list_rebuilds = 0;
     std::uint64_t list_rebuild_tests = 0;
     std::uint64_t repair_rounds = 0;          ///< Contact repair rounds run (limits and collision after the last collision).
+    int frame_repair_rounds = 0;              ///< Contact repair rounds in the last fixed step (all substeps).
+    std::uint64_t budget_hits = 0;            ///< Substeps whose contact repair stopped at its round budget with springs still over the limit.
     std::uint64_t non_finite_values = 0;      ///< Non-finite coordinates found (then the garment was reset).
     std::uint64_t resets = 0;                 ///< Resets (non-finite state, or reset_garment()).
     std::uint64_t steps = 0;                  ///< Fixed steps simulated.

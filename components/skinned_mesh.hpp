@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "drape/engine/assets/mesh_asset.hpp"
 #include "drape/engine/core/math.hpp"
@@ -20,6 +21,7 @@ struct SkinnedMesh {
     Matrix3X positions;   ///< World space, metres.
     Matrix3X normals;     ///< World space, unit.
     std::uint64_t skinned_vertices = 0;  ///< Vertices skinned into `positions` since spawn (a count, not a time).
+    std::vector<char> hidden;            ///< Per submesh, nonzero: not drawn (a modelled garment under a simulated one). Empty: all drawn.
 };
 
 }  // namespace drape

@@ -57,6 +57,7 @@ Result<void> apply_collider_overrides(Registry& registry, Entity character, std:
             if (o.rotation_deg) c.rotation = euler_deg(*o.rotation_deg);
             if (o.give_m) c.give_m = *o.give_m;
             c.initialised = false;
+            c.placed = false;  // its world transform is the old shape's until the next update
         }
     }
     return {};

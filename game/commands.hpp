@@ -18,6 +18,13 @@ void add_inspect_command(CLI::App& app);
 /// `drape make-avatar [--out FILE]`: writes the default avatar (assets/avatar.glb).
 void add_make_avatar_command(CLI::App& app);
 
+/// `drape export-motion CHARACTER --out FILE.bvh`: a character's clip as a BVH motion.
+void add_export_motion_command(CLI::App& app);
+
+void add_export_garment_command(CLI::App& app);
+
+void add_make_garments_command(CLI::App& app);
+
 /// `drape bench NAME`: benchmarks and reports (bench/).
 void add_bench_command(CLI::App& app);
 

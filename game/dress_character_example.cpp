@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
     auto body = drape::fit_character_body(**asset);
     if (!body) return fail_with(body.error().message);
 
-    // 2. Spawn: the character entity and one entity per collider, posed and skinned.
+    // 2. Spawn: the character entity and one entity per collider, posed, skinned and
+    //    placed: valid before the first step.
     drape::Registry registry;
     drape::SpawnOptions spawn;
     spawn.clip = clip;  // empty: the importer's first clip
@@ -71,8 +72,6 @@ int main(int argc, char** argv) {
     drape::add_cloth_systems(scheduler);
 
     // 4. The skirt: a cone hung from the fitted hip ellipsoids, top row pinned to the skin.
-    //    The builder fits around placed colliders: one pass of the skinning phase places them.
-    scheduler.run_phase(registry, drape::Phase::skinning, drape::FrameContext{.fixed_dt_s = 1.0 / 60.0});
     const drape::TubeParams skirt = drape::TubeParams::skirt();  // 27 x 31 = 837 particles, the paper's skirt
     auto garment = drape::attach_skirt(registry, *character, skirt);
     if (!garment) return fail_with(garment.error().message);

@@ -1,10 +1,11 @@
 // `drape play`: builds a scene (the sample scene by default), runs it for a number of
 // frames, writes what was asked (PNG frames, a video, a trace, stats) and prints the frame
-// budget. Usage and options: README.md "Playing scenes" and `drape play --help`.
+// budget and a verdict on every garment. Usage and options: docs/play.md and
+// `drape play --help`.
 //
 // play() is a sequence of steps, each a function below: check the options, load the scene,
 // apply the command-line overrides, build the world, open the outputs, run the frames,
-// close the outputs, print the budget, write the reports. Nothing is written before every
+// close the outputs, print the budget and the verdict, write the reports. Nothing is written before every
 // input has been checked and the world is built; a step that fails prints one line and
 // leaves nothing the run created behind (CreatedOutputs, game/output_files.hpp).
 #include <array>
@@ -21,7 +22,10 @@
 
 #include <unistd.h>
 
+#include "drape/engine/assets/garment_file.hpp"
 #include "drape/game/commands.hpp"
+#include "drape/game/contract.hpp"
+#include "drape/game/frame_hud.hpp"
 #include "drape/game/output_files.hpp"
 #include "drape/game/sample_scene.hpp"
 #include "drape/game/scene_file.hpp"
@@ -40,12 +44,13 @@ namespace {
 namespace fs = std::filesystem;
 
 struct PlayOptions {
-    std::string scene, character, clip, garment, model, out, video, trace, stats, size;
+    std::string scene, character, clip, motion, garment, model, integrator, out, video, trace, stats, size;
     std::optional<int> frames;
     std::optional<int> threads;
+    std::optional<int> trace_size;
     std::optional<double> time_scale;
     double fps = 60;
-    bool headless = false, window = false, overwrite = false;
+    bool headless = false, window = false, overwrite = false, strict = false, hud = false;
 };
 
 // Ctrl-C stops the loop between frames, so the video, stats and trace are still complete.
@@ -75,6 +80,7 @@ struct PlaySettings {
     std::pair<int, int> size{1280, 720};  ///< Frame size, px.
     bool headless = false;                ///< Nothing rendered (asked for, or no render module).
     bool window = false;                  ///< In an X11 window.
+    bool hud = false;                     ///< The frame budget overlay drawn from the start.
 };
 
 Result<PlaySettings> check_options(const PlayOptions& o) {
@@ -98,6 +104,9 @@ Result<PlaySettings> check_options(const PlayOptions& o) {
         s.headless = true;
     }
     s.window = o.window && !s.headless;
+    if (o.hud && s.headless) return fail("--hud: nothing is rendered (--headless, or no render module) to draw it on");
+    s.hud = o.hud || s.window;  // in a window it starts shown (the H key hides it)
+    if (o.trace_size && o.trace.empty()) return fail("--trace-size: needs --trace FILE (the trace it sizes)");
     if (!o.video.empty() && !find_ffmpeg())
         return fail("--video: ffmpeg is not installed (apt-get install ffmpeg); --out DIR writes PNG frames instead");
     if (!o.out.empty()) {
@@ -151,25 +160,39 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
         std::error_code ec;
         if (!fs::exists(file, ec)) return fail("--character: no such file: " + file.string());
         if (!fs::is_regular_file(file, ec)) return fail("--character: not a regular file: " + file.string());
-        if (scene.characters.empty()) scene.characters.emplace_back();
-        scene.characters[0].file = file;
-        scene.characters[0].clip.clear();  // the sample's clip name means nothing to another file
-        scene.characters[0].where = {};
-        // Overrides name bones of the scene's own character.
-        std::erase_if(scene.colliders, [](const ColliderOverride& c) { return c.character == 0; });
+        use_character_file(scene, file);
     }
     if (!o.clip.empty()) scene.characters.at(0).clip = o.clip;
+    if (!o.motion.empty()) {
+        const fs::path file = o.motion;
+        std::error_code ec;
+        if (!fs::is_regular_file(file, ec)) return fail("--motion: no such file: " + file.string());
+        if (!o.clip.empty()) return fail("--motion: give either --clip or --motion, not both");
+        scene.characters.at(0).motion = file;
+        scene.characters.at(0).clip.clear();
+    }
     if (!o.garment.empty()) {
         if (o.garment == "none") {
             scene.garments.clear();
         } else {
             GarmentDescription g;
-            g.type = o.garment == "dress" ? GarmentType::dress : GarmentType::skirt;
+            const bool built_in = o.garment == "skirt" || o.garment == "dress";
+            if (built_in) {
+                g.type = o.garment == "dress" ? GarmentType::dress : GarmentType::skirt;
+            } else {  // a garment file, FILE[:MESH]
+                auto [file, mesh] = split_garment_reference(o.garment);
+                std::error_code ec;
+                if (!fs::is_regular_file(file, ec))
+                    return fail("--garment: must be skirt, dress, none or a garment file (FILE[:MESH]); no such file: " + file.string());
+                g.file = std::move(file);
+                g.mesh = std::move(mesh);
+            }
             if (!scene.garments.empty()) {  // keep the look and solver choices of the scene's garment
                 g.model = scene.garments[0].model;
+                g.integrator = scene.garments[0].integrator;
                 g.collision = scene.garments[0].collision;
                 g.color = scene.garments[0].color;
-                if (scene.garments[0].type == g.type) g.parameters = scene.garments[0].parameters;
+                if (built_in && scene.garments[0].file.empty() && scene.garments[0].type == g.type) g.parameters = scene.garments[0].parameters;
             }
             scene.garments = {g};
         }
@@ -177,6 +200,9 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
     if (!o.model.empty())
         for (GarmentDescription& g : scene.garments)
             g.model = o.model == "classic" ? ClothModel::classic : ClothModel::simplified;
+    if (!o.integrator.empty())
+        for (GarmentDescription& g : scene.garments)
+            g.integrator = o.integrator == "paper" ? ClothIntegrator::paper : ClothIntegrator::shipped;
     if (o.threads) scene.solver.threads = *o.threads;
     if (o.time_scale) scene.solver.time_scale = *o.time_scale;
     return {};
@@ -195,12 +221,14 @@ Result<World> build_play_world(const SceneDescription& scene, const PlayOptions&
     options.window = s.window;
     options.width = s.size.first;
     options.height = s.size.second;
+    options.skin_penetration = !o.stats.empty();  // the stats file reports cloth behind the skin
     auto built = build_world(scene, options);
     if (!built) {
         // A value from the command line is named as the option the user typed.
         std::string message = built.error().message;
         for (const auto& [field, option, given] : {std::tuple{"characters[0].clip: ", "--clip: ", !o.clip.empty()},
-                                                   std::tuple{"characters[0].file: ", "--character: ", !o.character.empty()}})
+                                                   std::tuple{"characters[0].file: ", "--character: ", !o.character.empty()},
+                                                   std::tuple{"characters[0].motion: ", "--motion: ", !o.motion.empty()}})
             if (given && message.rfind(field, 0) == 0) message = option + message.substr(std::string_view(field).size());
         return fail(message);
     }
@@ -269,6 +297,7 @@ struct PlayRun {
 struct WindowControl {
     InputState input;
     bool paused = false;
+    bool hud = true;  ///< The overlay is shown (H).
     std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
 
     /// False when the window was closed or Q pressed.
@@ -286,6 +315,7 @@ struct WindowControl {
                     break;
                 }
                 case Action::reset: reset_garments(world); break;
+                case Action::toggle_hud: hud = !hud; break;
                 case Action::quit: break;
             }
         }
@@ -329,6 +359,8 @@ private:
     void (*m_previous)(int);
 };
 
+// With the overlay, a frame shows its own systems' times and the previous frame's whole
+// wall time (this one's is not over until it has been shown and recorded).
 Result<PlayRun> run_frames(World& world, const PlayOptions& o, const PlaySettings& s, PlayOutputs& out) {
     const int frames = o.frames.value_or(s.window ? 0 : 240);  // window: until closed unless --frames
     const double frame_dt_s = 1.0 / o.fps;
@@ -336,11 +368,15 @@ Result<PlayRun> run_frames(World& world, const PlayOptions& o, const PlaySetting
 #ifdef DRAPE_HAVE_RENDER
     WindowControl control;
     Image image;
+    FrameHud hud;
+    double wall_ms = 0;  // the previous frame's, from its start to the next one's
+    auto title_shown = std::chrono::steady_clock::now();
 #endif
     const InterruptScope interrupts;
     while ((frames == 0 || run.played < frames) && !g_interrupted) {
         double dt = frame_dt_s;
 #ifdef DRAPE_HAVE_RENDER
+        const auto start = std::chrono::steady_clock::now();
         if (s.window && !control.next_frame(world, dt)) break;
 #endif
         auto ticked = step_world(world, dt);
@@ -348,7 +384,16 @@ Result<PlayRun> run_frames(World& world, const PlayOptions& o, const PlaySetting
         if (ticked->dropped_s > 0) ++run.dropped_frames;
         ++run.played;
 #ifdef DRAPE_HAVE_RENDER
+        if (world.renderer && s.hud) {
+            hud.record(world, wall_ms);
+            if (!s.window || control.hud) world.renderer->draw_hud(hud.overlay());
+            if (s.window && start - title_shown >= std::chrono::milliseconds(250)) {
+                world.renderer->set_window_title(hud.title());
+                title_shown = start;
+            }
+        }
         if (auto ok = show_and_record(world, out, s.window, run.played - 1, image); !ok) return std::unexpected(ok.error());
+        wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 #else
         (void)out;
 #endif
@@ -386,7 +431,30 @@ void print_budget(const World& world, const PlayRun& run, const PlayOutputs& out
 }
 
 // ---------------------------------------------------------------------------------------
-// 9. Reports: the trace and the stats, each through a partial file; then the run's own
+// 9. The verdict: one line per garment on the quality contract (game/contract.hpp), on
+//    stdout when it was kept, as a warning on stderr when not. Returns the garments that
+//    broke it.
+int print_verdict(const World& world) {
+    if (world.watch.frames() == 0) return 0;  // nothing was measured
+    const RunStats stats = run_stats(world);
+    const std::vector<std::string> names = garment_names(world.scene);
+    int broken = 0;
+    for (std::size_t i = 0; i < stats.garments.size(); ++i) {
+        const std::string name = i < names.size() ? names[i] : "garments[" + std::to_string(i) + "]";
+        const std::string line = garment_verdict(name, stats.garments[i]);
+        if (contract_breaches(stats.garments[i]).empty()) {
+            std::printf("%s\n", line.c_str());
+        } else {
+            ++broken;
+            std::fflush(stdout);
+            std::fprintf(stderr, "drape play: warning: %s\n", line.c_str());
+        }
+    }
+    return broken;
+}
+
+// ---------------------------------------------------------------------------------------
+// 10. Reports: the trace and the stats, each through a partial file; then the run's own
 //    verdict. Each failure is reported; the exit status is 1 when any failed.
 
 /// Writes one report through a partial file; the error is prefixed with `option`.
@@ -405,9 +473,23 @@ Result<void> write_report(const char* option, const fs::path& file, Write write)
 
 int write_reports(const World& world, const PlayOptions& o) {
     int status = 0;
-    if (!o.trace.empty())
-        if (auto ok = write_report("--trace", o.trace, [&](const fs::path& p) { return world.scheduler.profiler().write_trace(p); }); !ok)
+    if (!o.trace.empty()) {
+        const FrameProfiler& profiler = world.scheduler.profiler();
+        if (auto ok = write_report("--trace", o.trace, [&](const fs::path& p) { return profiler.write_trace(p); }); !ok) {
             status = report(ok.error().message);
+        } else {
+            const auto recorded = static_cast<unsigned long long>(profiler.trace_events_recorded());
+            const auto dropped = static_cast<unsigned long long>(profiler.trace_events_dropped());
+            std::printf("trace: %s, %llu events\n", o.trace.c_str(), recorded - dropped);
+            if (dropped > 0) {
+                std::fflush(stdout);
+                std::fprintf(stderr,
+                             "drape play: warning: --trace: %llu of %llu events were dropped: the trace keeps the last %zu "
+                             "(--trace-size N keeps more)\n",
+                             dropped, recorded, profiler.trace_capacity());
+            }
+        }
+    }
     if (!o.stats.empty())
         if (auto ok = write_report("--stats", o.stats, [&](const fs::path& p) { return write_stats(run_stats(world), p); }); !ok)
             status = report(ok.error().message);
@@ -424,6 +506,7 @@ int play(const PlayOptions& o) {
     if (auto ok = apply_command_line(*scene, o); !ok) return report(ok.error().message);
     auto world = build_play_world(*scene, o, *settings);
     if (!world) return report(world.error().message);
+    if (o.trace_size) world->scheduler.profiler().set_trace_capacity(static_cast<std::size_t>(*o.trace_size));
     PlayOutputs outputs;
     if (auto ok = open_outputs(outputs, o, *settings); !ok) return report(ok.error().message);
 
@@ -436,7 +519,11 @@ int play(const PlayOptions& o) {
     if (run->interrupted) std::printf("drape play: interrupted after %d frames\n", run->played);
 
     print_budget(*world, *run, outputs, *settings);
-    return write_reports(*world, o);
+    const int broken = print_verdict(*world);
+    const int status = write_reports(*world, o);
+    if (broken > 0 && o.strict)
+        return report(std::to_string(broken) + " garment(s) outside the contract (--strict)");
+    return status;
 }
 
 }  // namespace
@@ -447,24 +534,36 @@ void add_play_command(CLI::App& app) {
     play_app->add_option("--scene", o->scene, "Scene file (JSON, see docs/scenes.md); default: the sample scene")->check(not_empty());
     play_app->add_option("--character", o->character, "Character file (.glb/.gltf/.fbx/...) replacing the scene's first character")->check(not_empty());
     play_app->add_option("--clip", o->clip, "Clip of the first character: name or index")->check(not_empty());
-    play_app->add_option("--garment", o->garment, "Dress the first character in a default skirt or dress, or nothing")
-        ->check(one_of({"skirt", "dress", "none"}));
+    play_app->add_option("--motion", o->motion,
+                         "BVH file whose motion drives the first character, retargeted by bone names (docs/characters.md)")
+        ->check(not_empty());
+    play_app->add_option("--garment", o->garment,
+                         "Dress the first character in a default skirt or dress, a garment file (FILE[:MESH], docs/garments.md), or nothing")
+        ->check(not_empty());
     play_app->add_option("--model", o->model, "Garment model: the paper's simplified mass-spring or the classic baseline")
         ->check(one_of({"simplified", "classic"}));
+    play_app->add_option("--integrator", o->integrator,
+                         "Garment integrator: the shipped solver or the paper's explicit scheme (docs/cloth.md)")
+        ->check(one_of({"shipped", "paper"}));
     play_app->add_option("--frames", o->frames, "Frames to play (default 240; in a window: until closed)")
         ->check(integer_in(1, 10'000'000));
     play_app->add_flag("--headless", o->headless, "No rendering at all (no render system)");
     play_app->add_option("--out", o->out, "Write every frame as PNG into this folder")->check(not_empty());
     play_app->add_option("--video", o->video, "Write an H.264 video (frames piped to ffmpeg)")->check(not_empty());
-    play_app->add_flag("--window", o->window, "Show the scene in an X11 window (mouse: orbit; keys: space, N, E, M, R, Q)");
+    play_app->add_flag("--window", o->window, "Show the scene in an X11 window (mouse: orbit; keys: space, N, E, M, R, H, Q)");
+    play_app->add_flag("--hud", o->hud,
+                       "Draw the frame budget overlay into the frames and video (in a window it is on; H toggles it)");
     play_app->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 1280x720)")->check(not_empty());
     play_app->add_option("--fps", o->fps, "Frames per second of off-screen playback and video (default 60)")
         ->check(number_in(1, 1000));
     play_app->add_option("--trace", o->trace, "Write Chrome trace event JSON (Perfetto, chrome://tracing)")->check(not_empty());
+    play_app->add_option("--trace-size", o->trace_size, "Trace events kept, the most recent (default 16384)")
+        ->check(integer_in(16, 10'000'000));
     play_app->add_option("--stats", o->stats, "Write run statistics JSON (systems, garments)")->check(not_empty());
     play_app->add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(integer_in(0, 1024));
     play_app->add_option("--time-scale", o->time_scale, "Simulated seconds per wall-clock second (slow motion < 1)")
         ->check(number_in(0, 1000));
+    play_app->add_flag("--strict", o->strict, "Exit with status 1 when a garment breaks the quality contract (the verdict)");
     play_app->add_flag("--overwrite", o->overwrite,
                        "Replace the --stats, --trace, --video files and --out frames if they exist (else: an error)");
     play_app->callback([o] { command_exit_code() = play(*o); });

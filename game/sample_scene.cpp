@@ -5,6 +5,14 @@
 
 namespace drape {
 
+void use_character_file(SceneDescription& scene, const std::filesystem::path& file) {
+    if (scene.characters.empty()) scene.characters.emplace_back();
+    scene.characters[0].file = file;
+    scene.characters[0].clip.clear();
+    scene.characters[0].where = {};
+    std::erase_if(scene.colliders, [](const ColliderOverride& c) { return c.character == 0; });
+}
+
 SceneDescription sample_scene() {
     SceneDescription scene;
     scene.description = "Drape's sample scene: the default avatar walking in place in a skirt";

@@ -29,6 +29,7 @@ Quat CharacterDescription::rotation() const {
 
 const char* garment_type_name(GarmentType t) noexcept { return t == GarmentType::skirt ? "skirt" : "dress"; }
 const char* cloth_model_name(ClothModel m) noexcept { return m == ClothModel::simplified ? "simplified" : "classic"; }
+const char* cloth_integrator_name(ClothIntegrator i) noexcept { return i == ClothIntegrator::paper ? "paper" : "shipped"; }
 const char* collision_mode_name(CollisionMode m) noexcept {
     return m == CollisionMode::candidate_lists ? "lists" : "brute_force";
 }

@@ -16,6 +16,7 @@
 
 #include "drape/components/garment.hpp"
 #include "drape/engine/core/math.hpp"
+#include "drape/systems/cloth/garment_from_mesh.hpp"
 
 namespace drape {
 
@@ -44,6 +45,9 @@ struct CharacterDescription {
     double speed = 1;                    ///< Playback rate of the clip.
     bool in_place = true;                ///< true: the walk stays in place; false: root motion moves the character.
     double start_s = 0;                  ///< Clip time at the start (where in its cycle the character begins), s.
+    bool hide_modelled_garments = true;  ///< Garments modelled into the file are not drawn while a garment is simulated on the character.
+    std::filesystem::path motion;        ///< A BVH file whose motion drives the character (retargeted) instead of its clips; empty: none.
+    std::vector<std::pair<std::string, std::string>> motion_bones;  ///< Motion joint -> bone, before the built-in matching.
     SourceLocation where;                ///< Of the "file" field, for load errors.
 
     [[nodiscard]] Quat rotation() const;
@@ -56,6 +60,7 @@ enum class GarmentType : std::uint8_t { skirt, dress };
 [[nodiscard]] const char* garment_type_name(GarmentType t) noexcept;
 [[nodiscard]] const char* cloth_model_name(ClothModel m) noexcept;
 [[nodiscard]] const char* collision_mode_name(CollisionMode m) noexcept;
+[[nodiscard]] const char* cloth_integrator_name(ClothIntegrator i) noexcept;
 
 /// One numeric garment parameter set in a scene: the name of a row of the garment
 /// parameter table (systems/cloth/garment_parameters.hpp) or "particles"
@@ -71,10 +76,18 @@ struct GarmentDescription {
     GarmentType type = GarmentType::skirt;
     int character = 0;                                   ///< Index into SceneDescription::characters.
     ClothModel model = ClothModel::simplified;
+    ClothIntegrator integrator = ClothIntegrator::shipped;  ///< docs/cloth.md "Two integrators".
     CollisionMode collision = CollisionMode::candidate_lists;
     std::optional<Vec3> color;                           ///< Linear RGB in [0, 1]; none: the garment's default.
     std::string material;                                ///< A material preset (silk, cotton, denim); empty: cotton.
     std::vector<GarmentParameter> parameters;            ///< Overrides of the builder's defaults (after the preset), in file order.
+    /// A garment from a file instead of the built-in `type` (docs/garments.md): the mesh,
+    /// modelled on the character as it stands when the garment is put on.
+    std::filesystem::path file;                          ///< Empty: the built-in `type`.
+    std::string mesh;                                    ///< The mesh's name in `file`; empty: its only mesh.
+    PinSource pins = PinSource::file;                    ///< Where it is held.
+    double spacing_m = 0;                                ///< Between lines and rows; 0: the mesh's own lattice, else 0.029 m.
+    GarmentPose modelled_on = GarmentPose::current;      ///< The pose the file's mesh was modelled on.
     SourceLocation where;                                ///< Of the garment object, for build errors.
     friend bool operator==(const GarmentDescription&, const GarmentDescription&) = default;
 };
@@ -103,6 +116,7 @@ struct SolverDescription {
     double max_frame_dt_s = 0.25;        ///< Longer frames (hitches) are clamped to this first.
     double teleport_threshold_m = 1.0;   ///< A body moving further in one step resets its garments.
     int threads = 0;                     ///< Worker threads; 0 = all cores.
+    double settle_s = 0.5;               ///< Garments put on settle this long on bodies held in their first pose; 0 = not at all.
     friend bool operator==(const SolverDescription&, const SolverDescription&) = default;
 };
 
@@ -123,6 +137,7 @@ struct SceneDescription {
     std::vector<CharacterDescription> characters;
     std::vector<GarmentDescription> garments;
     std::vector<ColliderOverride> colliders;
+    bool ground = true;                  ///< The floor at y = 0 (where it is drawn) is a collider for the garments.
     SolverDescription solver;
     CameraDescription camera;
     friend bool operator==(const SceneDescription&, const SceneDescription&) = default;

@@ -441,6 +441,26 @@ CharacterDescription read_character(const Reader& r, const std::string& path, co
     if (const Json* v = f.get("speed")) c.speed = read_real(r, f.path("speed"), *v, 0, 100);
     if (const Json* v = f.get("in_place")) c.in_place = read_bool(r, f.path("in_place"), *v);
     if (const Json* v = f.get("start_s")) c.start_s = read_real(r, f.path("start_s"), *v, 0, 100000);
+    if (const Json* v = f.get("hide_modelled_garments")) c.hide_modelled_garments = read_bool(r, f.path("hide_modelled_garments"), *v);
+    if (const Json* v = f.get("motion")) {
+        const std::string motion_path = f.path("motion");
+        c.motion = read_string(r, motion_path, *v, false);
+        if (c.motion.is_relative() && !r.base_dir().empty()) c.motion = r.base_dir() / c.motion;
+        c.motion = c.motion.lexically_normal();
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(c.motion, ec)) r.fail_at(motion_path, cat("no such file: ", c.motion.string()));
+        if (c.motion.extension() != ".bvh" && c.motion.extension() != ".BVH")
+            r.fail_at(motion_path, cat("must be a .bvh file, got ", c.motion.string()));
+        if (f.get("clip")) r.fail_at(motion_path, "give either clip or motion, not both");
+    }
+    if (const Json* v = f.get("motion_bones")) {
+        if (!v->is_object()) r.fail_at(f.path("motion_bones"), cat("must be an object of joint names to bone names, got ", typed(*v)));
+        else
+            for (const auto& [joint, bone] : v->items()) {
+                if (!bone.is_string()) r.fail_at(f.path("motion_bones") + "." + joint, cat("must be a bone name (string), got ", typed(bone)));
+                else c.motion_bones.emplace_back(joint, bone.get<std::string>());
+            }
+    }
     f.finish();
     return c;
 }
@@ -456,6 +476,9 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
     if (const Json* v = f.get("model"))
         g.model = read_choice<ClothModel>(r, f.path("model"), *v,
                                           {{"simplified", ClothModel::simplified}, {"classic", ClothModel::classic}});
+    if (const Json* v = f.get("integrator"))
+        g.integrator = read_choice<ClothIntegrator>(r, f.path("integrator"), *v,
+                                                    {{"shipped", ClothIntegrator::shipped}, {"paper", ClothIntegrator::paper}});
     if (const Json* v = f.get("collision"))
         g.collision = read_choice<CollisionMode>(r, f.path("collision"), *v,
                                                  {{"lists", CollisionMode::candidate_lists}, {"brute_force", CollisionMode::brute_force}});
@@ -472,6 +495,21 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
         if (v == nullptr) continue;
         g.parameters.push_back({std::string(spec->name), read_parameter(r, f.path(spec->name), *v, *spec)});  // in table order
     }
+    // A garment from a file: its mesh, where it is held, its grid's spacing.
+    if (const Json* v = f.get("file")) {
+        g.file = read_string(r, f.path("file"), *v, false);
+        if (g.file.is_relative() && !r.base_dir().empty()) g.file = r.base_dir() / g.file;
+        if (j.contains("type")) r.fail_at(f.path("type"), "give either type (a built-in garment) or file, not both", true);
+    }
+    if (const Json* v = f.get("mesh")) g.mesh = read_string(r, f.path("mesh"), *v, false);
+    if (const Json* v = f.get("pins"))
+        g.pins = read_choice<PinSource>(r, f.path("pins"), *v, {{"file", PinSource::file}, {"painted", PinSource::painted}, {"auto", PinSource::automatic}});
+    if (const Json* v = f.get("spacing_m")) g.spacing_m = read_real(r, f.path("spacing_m"), *v, 0, 1);
+    if (const Json* v = f.get("modelled_on"))
+        g.modelled_on = read_choice<GarmentPose>(r, f.path("modelled_on"), *v,
+                                                 {{"posed", GarmentPose::current}, {"bind", GarmentPose::bind}});
+    for (const char* key : {"mesh", "pins", "spacing_m", "modelled_on"})
+        if (g.file.empty() && j.contains(key)) r.fail_at(f.path(key), "applies to a garment from a file (give \"file\")", true);
     // Before a skirt and a dress shared one set of names, the ring height had one per type.
     for (const auto& [former, now] : {std::pair{"waist_height_fraction", "ring_height_fraction"}, {"waist_height_m", "ring_height_m"},
                                       {"shoulder_height_fraction", "ring_height_fraction"}, {"shoulder_height_m", "ring_height_m"}})
@@ -533,6 +571,7 @@ SolverDescription read_solver(const Reader& r, const Json& j) {
     if (const Json* v = f.get("teleport_threshold_m"))
         s.teleport_threshold_m = read_real(r, f.path("teleport_threshold_m"), *v, 0, max_coordinate_m, Bound::open);
     if (const Json* v = f.get("threads")) s.threads = read_int(r, f.path("threads"), *v, 0, 1024);
+    if (const Json* v = f.get("settle_s")) s.settle_s = read_real(r, f.path("settle_s"), *v, 0, 10);
     f.finish();
     return s;
 }
@@ -568,6 +607,7 @@ SceneDescription read_scene(const Reader& r, const Json& j) {
         for (std::size_t i = 0; i < colliders.size(); ++i)
             scene.colliders.push_back(read_collider(r, element_path("colliders", i), colliders[i], scene.characters.size()));
     }
+    if (const Json* v = f.get("ground")) scene.ground = read_bool(r, "ground", *v);
     if (const Json* v = f.get("solver")) scene.solver = read_solver(r, *v);
     if (const Json* v = f.get("camera")) scene.camera = read_camera(r, *v);
     f.finish();
@@ -667,15 +707,30 @@ std::string to_json(const SceneDescription& scene) {
         o["speed"] = c.speed;
         o["in_place"] = c.in_place;
         if (c.start_s != 0) o["start_s"] = c.start_s;
+        if (!c.hide_modelled_garments) o["hide_modelled_garments"] = false;
+        if (!c.motion.empty()) o["motion"] = c.motion.string();
+        if (!c.motion_bones.empty()) {
+            OrderedJson bones = OrderedJson::object();
+            for (const auto& [joint, bone] : c.motion_bones) bones[joint] = bone;
+            o["motion_bones"] = std::move(bones);
+        }
         characters.push_back(std::move(o));
     }
     j["characters"] = std::move(characters);
     OrderedJson garments = OrderedJson::array();
     for (const GarmentDescription& g : scene.garments) {
         OrderedJson o;
-        o["type"] = garment_type_name(g.type);
+        if (g.file.empty()) o["type"] = garment_type_name(g.type);
+        else {
+            o["file"] = g.file.string();
+            if (!g.mesh.empty()) o["mesh"] = g.mesh;
+            o["pins"] = g.pins == PinSource::painted ? "painted" : g.pins == PinSource::automatic ? "auto" : "file";
+            if (g.spacing_m > 0) o["spacing_m"] = g.spacing_m;
+            if (g.modelled_on == GarmentPose::bind) o["modelled_on"] = "bind";
+        }
         o["character"] = g.character;
         o["model"] = cloth_model_name(g.model);
+        if (g.integrator != ClothIntegrator::shipped) o["integrator"] = cloth_integrator_name(g.integrator);
         o["collision"] = collision_mode_name(g.collision);
         if (g.color) o["color"] = vec(*g.color);
         if (!g.material.empty()) o["material"] = g.material;
@@ -705,6 +760,7 @@ std::string to_json(const SceneDescription& scene) {
         }
         j["colliders"] = std::move(colliders);
     }
+    j["ground"] = scene.ground;
     const SolverDescription& s = scene.solver;
     j["solver"] = {{"fixed_dt_s", s.fixed_dt_s},
                    {"max_steps_per_frame", s.max_steps_per_frame},
@@ -714,7 +770,8 @@ std::string to_json(const SceneDescription& scene) {
                    {"max_substeps", s.max_substeps},
                    {"max_frame_dt_s", s.max_frame_dt_s},
                    {"teleport_threshold_m", s.teleport_threshold_m},
-                   {"threads", s.threads}};
+                   {"threads", s.threads},
+                   {"settle_s", s.settle_s}};
     const CameraDescription& c = scene.camera;
     j["camera"] = {{"follow", c.follow},       {"target_m", vec(c.target_m)}, {"distance_m", c.distance_m},
                    {"yaw_deg", c.yaw_deg},     {"pitch_deg", c.pitch_deg},   {"fov_deg", c.fov_deg}};

@@ -57,6 +57,7 @@ Result<TubeParams> tube_params(const GarmentDescription& garment) {
     // After the others: the grid keeps lines a multiple of the stride the scene chose.
     if (particles) grid_for(*particles, defaults.warp_lines, defaults.particles_per_line, p.weft_stride, p.warp_lines, p.particles_per_line);
     p.model = garment.model;
+    p.integrator = garment.integrator;
     p.collision = garment.collision;
     if (garment.color) p.color = *garment.color;
     return p;

@@ -1,21 +1,26 @@
 #include "drape/game/stats.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
 
 #include "drape/components/garment.hpp"
+#include "drape/game/skin_penetration.hpp"
 
 namespace drape {
 
-GarmentWatch::GarmentWatch(const Registry& registry, std::vector<Entity> garments) {
+GarmentWatch::GarmentWatch(const Registry& registry, std::vector<Entity> garments, int skin_every)
+    : m_skin_every(std::max(0, skin_every)) {
     for (Entity e : garments) {
         const Garment* g = registry.try_get<Garment>(e);
         Track t;
         t.entity = e;
         t.tests_at_start = g ? g->counters.collision_tests : 0;
         t.resets_at_start = g ? g->counters.resets : 0;
+        t.budget_hits_at_start = g ? g->counters.budget_hits : 0;
+        if (m_skin_every > 0) t.skin_depths.assign(skin_bins, 0);
         m_tracks.push_back(std::move(t));
     }
 }
@@ -26,18 +31,33 @@ void GarmentWatch::sample(const Registry& registry) {
     auto worse = [](double& worst, double value) {
         if (!std::isnan(worst) && (std::isnan(value) || value > worst)) worst = value;
     };
+    m_latest_strain_p99 = 0;
     for (Track& t : m_tracks) {
         const Garment* g = registry.try_get<Garment>(t.entity);
         if (g == nullptr) continue;
         const GarmentQuality q = measure_garment(registry, *g, t.strains.get());
+        m_latest_strain_p99 = std::max(m_latest_strain_p99, double(q.strain_p99));
         GarmentStats& w = t.worst;
         worse(w.strain_max, q.strain_max);
         worse(w.penetration_after_frame_m, q.penetration_m);
         worse(w.within_give_m, q.within_give_m);
         worse(w.pins_inside_m, q.pins_inside_m);
+        worse(w.below_ground_m, q.below_ground_m);
         worse(w.rise_above_pins_m, q.rise_above_pins_m);
+        if (std::isnan(q.compression_min) || q.compression_min < w.compression_min) w.compression_min = q.compression_min;
+        w.repair_rounds_max = std::max(w.repair_rounds_max, g->counters.frame_repair_rounds);
         worse(w.penetration_before_response_m, g->counters.max_penetration_m);
         w.nonfinite += q.nonfinite;
+        if (m_skin_every > 0 && (m_frames - 1) % static_cast<std::uint64_t>(m_skin_every) == 0) {
+            const SkinDepths d = skin_depths(registry, *g);
+            t.skin_measured = t.skin_measured || d.measured;
+            t.skin_free += d.free;
+            t.skin_behind += d.behind_m.size();
+            for (const double depth : d.behind_m) {
+                worse(w.skin_penetration_max_m, depth);
+                ++t.skin_depths[std::min(skin_bins - 1, static_cast<std::size_t>(depth / skin_bin_m))];
+            }
+        }
     }
 }
 
@@ -46,10 +66,25 @@ std::vector<GarmentStats> GarmentWatch::result(const Registry& registry) const {
     for (const Track& t : m_tracks) {
         GarmentStats s = t.worst;
         s.strain_p99 = t.strains->percentile(0.99);
+        s.skin_measured = t.skin_measured;
+        if (t.skin_measured && t.skin_free > 0) {
+            s.skin_penetration_share = double(t.skin_behind) / double(t.skin_free);
+            // Upper edge of the bin that holds the 99th percentile of the depths.
+            const auto rank = static_cast<std::uint64_t>(std::ceil(0.99 * double(t.skin_behind)));
+            std::uint64_t seen = 0;
+            for (std::size_t b = 0; b < t.skin_depths.size() && t.skin_behind > 0; ++b) {
+                seen += t.skin_depths[b];
+                if (seen >= rank) {
+                    s.skin_penetration_p99_m = std::min(double(b + 1) * skin_bin_m, s.skin_penetration_max_m);
+                    break;
+                }
+            }
+        }
         if (const Garment* g = registry.try_get<Garment>(t.entity)) {
             s.particles = static_cast<std::uint64_t>(g->state.x.cols());
             s.nonfinite += g->counters.non_finite_values;
             s.resets = g->counters.resets - t.resets_at_start;
+            s.budget_hits = g->counters.budget_hits - t.budget_hits_at_start;
             if (m_frames > 0)
                 s.collision_tests_per_frame = double(g->counters.collision_tests - t.tests_at_start) / double(m_frames);
         }
@@ -86,15 +121,24 @@ std::string stats_json(const RunStats& stats) {
     for (const GarmentStats& g : stats.garments)
         garments.push_back({{"particles", g.particles},
                             {"strain", {{"max", number(g.strain_max)}, {"p99", number(g.strain_p99)}}},
+                            {"compression_min", number(g.compression_min)},
                             {"penetration_m",
                              {{"after_frame_max", number(g.penetration_after_frame_m)},
                               {"before_response_max", number(g.penetration_before_response_m)},
-                              {"within_give_max", number(g.within_give_m)}}},
+                              {"within_give_max", number(g.within_give_m)},
+                              {"below_ground_max", number(g.below_ground_m)}}},
+                            {"skin_penetration_m",
+                             g.skin_measured ? Json{{"p99", number(g.skin_penetration_p99_m)},
+                                                    {"max", number(g.skin_penetration_max_m)},
+                                                    {"share", number(g.skin_penetration_share)}}
+                                             : Json{{"p99", nullptr}, {"max", nullptr}, {"share", nullptr}}},
                             {"pins_inside_m", number(g.pins_inside_m)},
                             {"rise_above_pins_m", number(g.rise_above_pins_m)},
                             {"nonfinite", g.nonfinite},
                             {"resets", g.resets},
                             {"collision_tests_per_frame", number(g.collision_tests_per_frame)},
+                            {"repair_rounds_max", g.repair_rounds_max},
+                            {"budget_hits", g.budget_hits},
                             {"max_strain", number(g.strain_max)},
                             {"max_penetration_m", number(g.penetration_before_response_m)}});
     Json j = {{"frames", stats.frames},          {"sim_dt_s", number(stats.sim_dt_s)}, {"characters", std::move(characters)},

@@ -1,17 +1,22 @@
 // Worlds built from scene descriptions; see world.hpp.
 #include "drape/game/world.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <optional>
 
 #include <tbb/global_control.h>
 
 #include "drape/components/animation_player.hpp"
 #include "drape/components/character.hpp"
 #include "drape/components/garment.hpp"
+#include "drape/components/ground_plane.hpp"
 #include "drape/components/skeleton.hpp"
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/character_import.hpp"
+#include "drape/engine/assets/garment_file.hpp"
 #include "drape/game/collider_overrides.hpp"
 #include "drape/game/scene_file.hpp"
 #include "drape/game/scene_garment_parameters.hpp"
@@ -21,11 +26,14 @@
 #include "drape/systems/character/spawn.hpp"
 #include "drape/systems/cloth/garment_builder.hpp"
 #include "drape/systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth/garment_from_mesh.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 #include "drape/systems/cloth_systems.hpp"
 #include "drape/systems/teleport_guard_system.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
 #include "drape/engine/render/renderer.hpp"
+#include "drape/systems/garment_surface_system.hpp"
 #include "drape/systems/render_system.hpp"
 #include "drape/systems/skin_cover_system.hpp"
 #include "drape/systems/skinning_system.hpp"
@@ -39,6 +47,55 @@ namespace {
 
 constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
 
+// A garment from a file (docs/garments.md) on `body`: its mesh imported, gridded and held
+// as MeshGarmentParams says, the cloth from `params` (the scene's material, model, colour,
+// weft_stride and fitting_rows); the built-in garments' shape parameters do not apply. A
+// file that paints no pins, held at its higher edge instead, adds a line to `warnings`.
+Result<Entity> attach_file_garment(Registry& registry, Entity body, const GarmentDescription& g, const TubeParams& params,
+                                   const std::string& field, std::vector<std::string>& warnings) {
+    for (const GarmentParameter& p : g.parameters) {
+        const GarmentParameterSpec* spec = find_garment_parameter(p.name);
+        if (p.name != "weft_stride" && p.name != "fitting_rows" && p.name != "inertia_linear" && p.name != "inertia_angular" &&
+            !(spec && spec->in_material()))
+            return fail(field + "." + p.name + ": shapes a built-in garment; a garment from a file has its own shape");
+    }
+    MeshGarmentParams mp;
+    mp.spacing_m = static_cast<Real>(g.spacing_m);
+    mp.modelled_on = g.modelled_on;
+    mp.weft_stride = params.weft_stride;
+    mp.pins = g.pins;
+    mp.fitting_rows = params.fitting_rows;
+    mp.config.model = params.model;
+    mp.config.integrator = params.integrator;
+    mp.config.collision = params.collision;
+    mp.config.material = params.material;
+    mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular};
+    mp.config.color = params.color;
+    auto mesh = import_garment_mesh(g.file, g.mesh);
+    if (!mesh) return std::unexpected(mesh.error());
+    if (g.pins == PinSource::file && mesh->pin.size() == 0)
+        warnings.push_back(field + ": " + g.file.string() + " paints no pins (COLOR_0): held at its higher edge, " +
+                           std::to_string(mp.fitting_rows) + (mp.fitting_rows == 1 ? " row" : " rows"));
+    return attach_mesh_garment(registry, body, *mesh, mp, field);
+}
+
+// Putting the garments on: each was built around its body in the pose its clip starts in;
+// it now settles there for solver.settle_s, every body held in that pose (no animation
+// step, so the colliders stand still), before the first frame. A garment built straight
+// into a stride (a thigh raised into the tube, an arm across it) is pushed out of the body
+// and falls still here instead of being flung up over the chest in the played frames.
+// These steps are not frames: nothing is drawn, and the stats and the profile start after.
+void settle_garments(World& world) {
+    const SolverDescription& solver = world.scene.solver;
+    if (world.garments.empty() || !(solver.settle_s > 0)) return;
+    const int steps = static_cast<int>(std::ceil(solver.settle_s / solver.fixed_dt_s - 1e-9));
+    for (int step = 0; step < steps; ++step) {
+        const FrameContext context{.fixed_dt_s = solver.fixed_dt_s, .time_s = step * solver.fixed_dt_s, .step = step, .steps = steps};
+        world.scheduler.run_phase(world.registry, Phase::skinning, context);
+        world.scheduler.run_phase(world.registry, Phase::simulation, context);
+    }
+}
+
 }  // namespace
 
 bool render_available() noexcept {
@@ -48,6 +105,22 @@ bool render_available() noexcept {
     return false;
 #endif
 }
+
+namespace {
+
+/// How far to raise a character placed by `t` so that its lowest point in the bind pose
+/// rests on the floor, when that point lies more than a tenth of its height from its
+/// origin's level (a file whose origin is at its feet, soles a little below or above it,
+/// stays where it is put).
+std::optional<Real> floor_lift(const CharacterAsset& asset, const Transform& t) {
+    if (!asset.mesh || asset.mesh->bind_positions.cols() == 0) return std::nullopt;
+    const Matrix3X posed = (t.rotation.toRotationMatrix() * static_cast<Real>(t.scale)) * asset.mesh->bind_positions;
+    const Real low = posed.row(1).minCoeff(), high = posed.row(1).maxCoeff();
+    if (!std::isfinite(low) || !std::isfinite(high) || std::abs(low) <= Real(0.1) * (high - low)) return std::nullopt;
+    return -low;
+}
+
+}  // namespace
 
 Result<World> build_world(const SceneDescription& scene, const WorldOptions& options) {
     if (auto ok = validate(scene); !ok) return std::unexpected(ok.error());
@@ -84,19 +157,49 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
             if (!body) return fail(located(c.where, field, body.error().message));
             character = {*imported, std::move(*body)};
             world.warnings.insert(world.warnings.end(), character.asset->warnings.begin(), character.asset->warnings.end());
+            // Where Drape had to guess, one line each: the units, the landmarks.
+            if (character.asset->scale_source == ScaleSource::fallback)
+                world.warnings.push_back(c.file.string() + ": units: " + character.asset->units_note);
+            if (!character.body.landmarks)
+                world.warnings.push_back(character.body.landmarks_error +
+                                         "; garments hang at a fixed share of its height, around the mean of its ellipsoids");
         }
-        const std::shared_ptr<const CharacterAsset>& asset = character.asset;
+        std::shared_ptr<const CharacterAsset> asset = character.asset;
+        if (!c.motion.empty()) {
+            // A BVH motion: retargeted onto this skeleton, played as the character's clip.
+            std::vector<std::string> notes;
+            auto motion = import_bvh_motion(c.motion, *asset->skeleton, MotionRetarget{c.motion_bones}, &notes);
+            if (!motion) return fail(located(c.where, "characters[" + std::to_string(i) + "].motion", motion.error().message));
+            world.warnings.insert(world.warnings.end(), notes.begin(), notes.end());
+            auto with_motion = std::make_shared<CharacterAsset>(*asset);
+            with_motion->clips.push_back(*motion);
+            asset = std::move(with_motion);
+        }
         SpawnOptions spawn;
         spawn.transform.position = c.position_m;
         spawn.transform.rotation = c.rotation();
         spawn.transform.scale = c.scale;
-        spawn.clip = c.clip;
+        if (scene.ground) {
+            // On the floor: a file whose origin is not at its feet (a model centred on its
+            // origin) stands with its lowest point on the floor instead of through it.
+            if (const auto lift = floor_lift(*asset, spawn.transform)) {
+                spawn.transform.position.y() += *lift;
+                char line[160];
+                std::snprintf(line, sizeof line, ": placed on the floor: its lowest point lies %.2f m %s its origin", std::abs(*lift),
+                              *lift > 0 ? "below" : "above");
+                world.warnings.push_back(c.file.string() + line);
+            }
+        }
+        spawn.clip = c.motion.empty() ? c.clip : std::to_string(asset->clips.size() - 1);
         spawn.speed = c.speed;
         spawn.in_place = c.in_place;
         spawn.start_time_s = c.start_s;
-        if (!c.clip.empty()) {
+        if (!c.clip.empty()) {  // (with a motion there is none: the motion is the clip)
             if (auto clip = find_clip(*asset, c.clip); !clip)
                 return fail(located(c.where, "characters[" + std::to_string(i) + "].clip", clip.error().message));
+        } else if (const auto choice = choose_default_clip(*asset); c.motion.empty() && choice && choice->fell_back) {
+            const std::string line = c.file.string() + ": clip: no walk and no looping locomotion clip; playing " + choice->reason;
+            if (std::find(world.warnings.begin(), world.warnings.end(), line) == world.warnings.end()) world.warnings.push_back(line);
         }
         auto entity = spawn_character(world.registry, asset, character.body, spawn);
         if (!entity) return fail(located(c.where, "characters[" + std::to_string(i) + "]", entity.error().message));
@@ -104,6 +207,9 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         if (auto ok = apply_collider_overrides(world.registry, *entity, i, scene.colliders, *asset); !ok)
             return std::unexpected(ok.error());
     }
+
+    // The floor the garments fall onto.
+    if (scene.ground) world.registry.emplace<GroundPlane>(world.registry.create(), GroundPlane{.height_m = 0});
 
     // Systems: characters, teleport guard, cloth (+ fixed substeps), render.
     add_character_systems(world.scheduler);
@@ -124,12 +230,27 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         const Entity body = world.characters.at(static_cast<std::size_t>(g.character));
         auto params = tube_params(g);
         if (!params) return fail(located(g.where, field, params.error().message));
-        const Result<Entity> garment = g.type == GarmentType::skirt ? attach_skirt(world.registry, body, *params)
-                                                                    : attach_dress(world.registry, body, *params);
+        const Result<Entity> garment = !g.file.empty()                ? attach_file_garment(world.registry, body, g, *params, field, world.warnings)
+                                       : g.type == GarmentType::skirt ? attach_skirt(world.registry, body, *params)
+                                                                      : attach_dress(world.registry, body, *params);
         if (!garment) return fail(located(g.where, field, garment.error().message));
         world.garments.push_back(*garment);
     }
-    world.watch = GarmentWatch(world.registry, world.garments);
+    // A garment simulated over one modelled into the file: the modelled one is not drawn.
+    for (std::size_t i = 0; i < scene.characters.size(); ++i) {
+        const CharacterDescription& c = scene.characters[i];
+        const bool dressed = std::any_of(scene.garments.begin(), scene.garments.end(),
+                                         [&](const GarmentDescription& g) { return g.character == static_cast<int>(i); });
+        auto* skin = world.registry.try_get<SkinnedMesh>(world.characters[i]);
+        if (!dressed || !c.hide_modelled_garments || skin == nullptr || !skin->mesh) continue;
+        for (const LeftOutMesh& part : loaded.at(c.file).body.left_out)
+            if (part.garment && part.mesh < skin->mesh->submeshes.size()) {
+                skin->hidden.resize(skin->mesh->submeshes.size(), 0);
+                skin->hidden[part.mesh] = 1;
+            }
+    }
+    settle_garments(world);
+    world.watch = GarmentWatch(world.registry, world.garments, options.skin_penetration ? options.skin_penetration_every : 0);
     world.scheduler.profiler().reset();  // the profile is of played frames, not of the set-up pass
 
     // Renderer.
@@ -153,6 +274,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         // The mesh is skinned for drawing only, once per frame, just before it is drawn.
         world.scheduler.add(make_skinning_system());
         world.scheduler.add(make_skin_cover_system());
+        world.scheduler.add(make_garment_surface_system());
         world.scheduler.add(make_render_system(*world.renderer));
 #else
         return fail("rendering: this build has no render module (configured with -DDRAPE_RENDER=OFF)");

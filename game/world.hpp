@@ -6,6 +6,11 @@
 //   auto world = drape::build_world(*scene, {});           // headless
 //   for (int i = 0; i < 600; ++i) drape::step_world(*world, 1.0 / 60.0);
 //
+// Putting the garments on (docs/characters.md): build_world builds each garment around its
+// body in the pose the clip starts in and lets it settle there for `solver.settle_s`, the
+// bodies held still, before returning; those steps are not frames (nothing drawn, not in the
+// stats or the profile).
+//
 // Systems, in phase order (engine/core/scheduler.hpp): the character systems (animation,
 // colliders), then the teleport guard (systems/teleport_guard_system.hpp), then the cloth
 // systems, then, only when rendering, the skinning system (the mesh, once per frame) and
@@ -46,6 +51,8 @@ struct WorldOptions {
     /// Folder where fitted bodies are kept between runs (systems/character/body_cache.hpp); empty: the
     /// folder DRAPE_BODY_CACHE names, or none.
     std::filesystem::path body_cache;
+    bool skin_penetration = false;   ///< Measure cloth behind the skin mesh (game/skin_penetration.hpp; costs a skinning and a search per measured frame) ...
+    int skin_penetration_every = 1;  ///< ... after every this many frames (1: every frame).
 };
 
 /// A running scene: its description, registry, scheduler with the systems, its entities,

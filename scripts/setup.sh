@@ -6,13 +6,19 @@ set -euo pipefail
 DRAPE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 DRAPE_BUILD_DIR=${DRAPE_BUILD_DIR:-"$DRAPE_ROOT/build"}
 
-# Debian packages Drape builds, tests and benchmarks with.
-DRAPE_PACKAGES=(
-  build-essential cmake pkg-config git
+# Debian packages: what building and playing needs (scripts/play), and what the tests and
+# benchmarks add (scripts/test).
+DRAPE_PLAY_PACKAGES=(
+  build-essential cmake
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libstb-dev
-  libgtest-dev libgmock-dev googletest libbenchmark-dev
-  libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
-  libbullet-dev ffmpeg gnuplot-nox xvfb xauth
+  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
+  ffmpeg
+)
+DRAPE_TEST_PACKAGES=(
+  "${DRAPE_PLAY_PACKAGES[@]}"
+  pkg-config git libgles-dev
+  libgtest-dev libgmock-dev googletest libbenchmark-dev libbullet-dev
+  gnuplot-nox xvfb xauth
 )
 
 drape_log() { printf 'drape: %s\n' "$*" >&2; }
@@ -54,21 +60,44 @@ drape_timed() {
   return "$rc"
 }
 
-# Configures (once) and builds incrementally in $DRAPE_BUILD_DIR, Release. With ccache
-# installed it is the compiler launcher, its base directory the checkout, so that a clone
-# in another folder is served from the same cache. ccache takes -march=native as written,
-# not as the CPU it means: the compiler's target options for this CPU are its compiler
-# check, so that another CPU does not get this one's objects.
+# True when the build folder's cache holds every -DNAME=VALUE of the arguments.
+drape_cache_has() {
+  local cache="$DRAPE_BUILD_DIR/CMakeCache.txt" arg name value
+  [ -f "$cache" ] || return 1
+  for arg in "$@"; do
+    [[ "$arg" =~ ^-D([A-Za-z_0-9]+)=(.*)$ ]] || continue
+    name=${BASH_REMATCH[1]}
+    value=${BASH_REMATCH[2]}
+    grep -q "^${name}:[A-Z]*=${value}\$" "$cache" || return 1
+  done
+}
+
+# drape_build [--target TARGET] [-DNAME=VALUE...]: configures (Release) when there is no
+# build yet, when DRAPE_CMAKE_ARGS is set or when the cache differs from the -D values
+# asked for, then builds incrementally in $DRAPE_BUILD_DIR: TARGET only, or everything.
+# With ccache installed it is the compiler launcher, its base directory the checkout, so
+# that a clone in another folder is served from the same cache. ccache takes -march=native
+# as written, not as the CPU it means: the compiler's target options for this CPU are its
+# compiler check, so that another CPU does not get this one's objects.
 drape_build() {
+  local target=() args=()
+  while [ $# -gt 0 ]; do
+    if [ "$1" = "--target" ]; then
+      target=(--target "$2")
+      shift 2
+    else
+      args+=("$1")
+      shift
+    fi
+  done
   local extra=(${DRAPE_CMAKE_ARGS:-})
-  local launcher=()
   if command -v ccache >/dev/null 2>&1; then
     export CCACHE_BASEDIR="$DRAPE_ROOT"
     export CCACHE_COMPILERCHECK="%compiler% -march=native -Q --help=target"
-    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   fi
-  if [ ! -f "$DRAPE_BUILD_DIR/CMakeCache.txt" ] || [ ${#extra[@]} -gt 0 ]; then
-    cmake -S "$DRAPE_ROOT" -B "$DRAPE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${extra[@]}" "$@" >/dev/null
+  if [ ${#extra[@]} -gt 0 ] || ! drape_cache_has "${args[@]}"; then
+    cmake -S "$DRAPE_ROOT" -B "$DRAPE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${args[@]}" "${extra[@]}" >/dev/null
   fi
-  drape_timed "build ($DRAPE_BUILD_DIR)" cmake --build "$DRAPE_BUILD_DIR" --parallel "$(nproc)"
+  drape_timed "build ($DRAPE_BUILD_DIR)" cmake --build "$DRAPE_BUILD_DIR" --parallel "$(nproc)" "${target[@]}"
 }

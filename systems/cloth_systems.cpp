@@ -6,14 +6,13 @@
 #include <memory>
 #include <optional>
 
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
+#include <vector>
 
 #include "drape/components/ellipsoid_collider.hpp"
 #include "drape/components/garment.hpp"
 #include "drape/components/skeleton.hpp"
 #include "drape/components/transform.hpp"
+#include "drape/engine/core/jobs.hpp"
 #include "drape/systems/cloth/garment_batch.hpp"
 #include "drape/systems/cloth_collision_system.hpp"
 #include "drape/systems/cloth_constraint_system.hpp"
@@ -84,11 +83,9 @@ void run_step(Registry& registry, GarmentBatch& all, double fixed_dt_s, const Cl
         return;
     }
     const bool timed = profiler != nullptr && slots.timed && profiler->timing();
-    tbb::enumerable_thread_specific<StageTimes> per_thread;
+    std::vector<StageTimes> per_item(timed ? all.items.size() : 0);
     const auto start = FrameProfiler::Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, all.items.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) step_item(all.items[i], timed ? &per_thread.local() : nullptr);
-    });
+    job_system().parallel_for(all.items.size(), [&](std::size_t i) { step_item(all.items[i], timed ? &per_item[i] : nullptr); });
     const auto end = FrameProfiler::Clock::now();
     if (profiler == nullptr || !slots.timed) return;
     if (!timed) {
@@ -96,7 +93,7 @@ void run_step(Registry& registry, GarmentBatch& all, double fixed_dt_s, const Cl
         return;
     }
     StageTimes sum;
-    for (const StageTimes& t : per_thread)
+    for (const StageTimes& t : per_item)
         for (std::size_t k = 0; k < sum.ns.size(); ++k) sum.ns[k] += t.ns[k];
     const double total = static_cast<double>(sum.ns[0] + sum.ns[1] + sum.ns[2]);
     const double wall = static_cast<double>((end - start).count());

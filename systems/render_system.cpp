@@ -8,7 +8,9 @@
 #include "drape/components/character.hpp"
 #include "drape/components/ellipsoid_collider.hpp"
 #include "drape/components/garment.hpp"
+#include "drape/components/garment_surface.hpp"
 #include "drape/components/skinned_mesh.hpp"
+#include "drape/systems/garment_surface_system.hpp"
 #include "drape/systems/skin_cover_system.hpp"
 #include "drape/systems/skinning_system.hpp"
 
@@ -39,7 +41,15 @@ void add_skinned_meshes(Registry& registry, DrawList& list) {
         draw.positions = &skin.positions;
         draw.normals = skin.normals.cols() == skin.positions.cols() ? &skin.normals : nullptr;
         draw.triangles = mesh.indices;
-        for (const Submesh& s : mesh.submeshes) draw.ranges.push_back({s.first_index, s.index_count, s.color, s.name});
+        for (std::size_t i = 0; i < mesh.submeshes.size(); ++i) {
+            if (i < skin.hidden.size() && skin.hidden[i]) continue;
+            const Submesh& s = mesh.submeshes[i];
+            draw.ranges.push_back({s.first_index, s.index_count, s.color, s.name});
+        }
+        if (draw.ranges.empty() && !mesh.submeshes.empty()) {  // every part hidden (no ranges would draw them all)
+            list.meshes.pop_back();
+            return;
+        }
         draw.contact_shadow = true;
     });
 }
@@ -53,7 +63,18 @@ void add_garments(Registry& registry, DrawList& list) {
         draw.positions = &garment.state.x;
         draw.normals = nullptr;  // from the particles, every frame
         draw.triangles = garment.fabric->triangles;
-        draw.color = garment.config.color;
+        // Drawn as authored: the artist's mesh where the garment surface system placed it.
+        if (const auto* surface = registry.try_get<GarmentSurface>(e);
+            surface && !surface->triangles.empty() && surface->positions.cols() == static_cast<Eigen::Index>(surface->carriers.size())) {
+            draw.positions = &surface->positions;
+            draw.normals = &surface->normals;
+            draw.triangles = surface->triangles;
+            if (surface->base_color && surface->uvs.cols() == surface->positions.cols()) {
+                draw.texture = surface->base_color.get();
+                draw.uvs = &surface->uvs;
+            }
+        }
+        draw.color = draw.texture != nullptr ? Vec3::Ones() : garment.config.color;
         draw.look = cloth_look;
     });
 }
@@ -116,7 +137,7 @@ System make_render_system(Renderer& renderer) {
     system.name = "render";
     system.phase = Phase::render;
     system.reads = components<SkinnedMesh>();
-    system.optional_reads = components<Garment, EllipsoidCollider, Character>();
+    system.optional_reads = components<Garment, GarmentSurface, EllipsoidCollider, Character>();
     // The list lives with the system, so its buffers are reused from frame to frame.
     system.run = [&renderer, first = true, list = DrawList{}](Registry& registry, const FrameContext& context) mutable {
         update_follow_camera(renderer.camera(), registry, first ? 0.0 : context.frame_dt_s);
@@ -134,6 +155,7 @@ Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& reg
     Image image;
     System skinning = make_skinning_system();
     System cover = make_skin_cover_system();
+    System surfaces = make_garment_surface_system();
     System system = make_render_system(renderer);
     FrameContext context;
     context.frame_dt_s = 1.0 / 60.0;
@@ -142,6 +164,7 @@ Result<std::vector<double>> time_render_frames(Renderer& renderer, Registry& reg
         context.frame = static_cast<std::uint64_t>(i);
         skinning.run(registry, context);
         cover.run(registry, context);
+        surfaces.run(registry, context);
         system.run(registry, context);
         if (readback) {
             if (auto ok = renderer.read_pixels(image); !ok) return fail(ok.error().message);

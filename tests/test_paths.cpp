@@ -8,6 +8,8 @@ namespace drape::test {
 std::filesystem::path source_dir() { return DRAPE_SOURCE_DIR; }
 std::filesystem::path binary_dir() { return DRAPE_BINARY_DIR; }
 std::filesystem::path shared_assets() { return DRAPE_SHARED_ASSETS; }
+const char* version() { return DRAPE_VERSION; }
+const char* machine_flags() { return DRAPE_MACHINE_FLAGS; }
 
 namespace {
 

@@ -30,6 +30,10 @@ struct AnimationClip {
     int motion_bone = -1;
     Vec3 travel_m = Vec3::Zero();   ///< Horizontal model-space travel of `motion_bone` over one cycle.
     Vec3 travel_local = Vec3::Zero();  ///< The same in the motion bone's parent space.
+    /// > 0: the clip nearly loops (its last pose is within a few degrees of its first but not
+    /// on it, as exports of a cycle often are); played as a loop, its pose is blended into
+    /// its first over this last stretch of the clip, so the seam does not jump. 0: none.
+    double seam_blend_s = 0;
 };
 
 }  // namespace drape

@@ -24,7 +24,7 @@ enum class ScaleSource : std::uint8_t {
     option,     ///< ImportOptions::scale.
     height,     ///< ImportOptions::height_m.
     file_units, ///< The file's unit metadata (FBX UnitScaleFactor, COLLADA <unit>, glTF = metres).
-    fallback,   ///< File units gave an implausible height; scaled to ImportOptions::fallback_height_m.
+    fallback,   ///< The file states no unit, or its unit gives an implausible height: scaled to ImportOptions::fallback_height_m.
 };
 [[nodiscard]] const char* scale_source_name(ScaleSource source) noexcept;
 
@@ -34,6 +34,7 @@ struct MeshInfo {
     std::uint32_t first_vertex = 0;
     std::uint32_t vertex_count = 0;
     bool rigid = false;   ///< Had no skin: bound with weight 1 to the bone it hangs from.
+    std::string material; ///< Its material's name ("" when it has none).
 };
 
 struct CharacterAsset {
@@ -46,6 +47,9 @@ struct CharacterAsset {
     Real height_m = 0;                                  ///< Vertical extent of the rest pose.
     double scale = 1;                                   ///< File units -> metres that was applied.
     ScaleSource scale_source = ScaleSource::file_units;
+    /// What the file states of its units and up axis ("FBX UnitScaleFactor 1 (1 unit =
+    /// 1 cm), UpAxis Y"), and with ScaleSource::fallback why its units were not used; one line.
+    std::string units_note;
     int skin_bones = 0;                                 ///< Bones that move at least one vertex.
     /// What the import accepted but a user may want to know (e.g. zero-length end bones
     /// without weights): one line each, naming the file.

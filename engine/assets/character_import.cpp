@@ -12,6 +12,7 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <fstream>
 #include <numeric>
@@ -116,6 +117,46 @@ Mat3 fbx_axes(const aiScene* scene) {
     if (!up || !front || !coord) return Mat3::Identity();
     return axes_to_drape(int(*up), up_sign && *up_sign < 0 ? -1 : 1, int(*front), front_sign && *front_sign < 0 ? -1 : 1,
                          int(*coord), coord_sign && *coord_sign < 0 ? -1 : 1);
+}
+
+const char* axis_name(double axis, double sign) {
+    static const char* names[] = {"-X", "-Y", "-Z", "X", "Y", "Z"};
+    const int a = static_cast<int>(axis);
+    return a >= 0 && a <= 2 ? names[a + (sign < 0 ? 0 : 3)] : "?";
+}
+
+// What a file states of its units (metres per file unit) and up axis, and the line saying so.
+struct FileUnits {
+    std::optional<double> metres_per_unit;  ///< None: the file states no unit.
+    std::string stated;
+};
+
+FileUnits file_units(const aiScene* scene, const std::filesystem::path& path) {
+    FileUnits out;
+    char text[160];
+    std::string extension = path.extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension == ".glb" || extension == ".gltf") {
+        out.metres_per_unit = 1;
+        out.stated = "glTF: metres, Y up (the format's own)";
+    } else if (extension == ".dae") {
+        out.metres_per_unit = 1;  // assimp applies <unit> and <up_axis> itself (metres and Y up when absent)
+        out.stated = "COLLADA: its <unit> and <up_axis>, applied on reading";
+    } else if (source_format_contains(scene, "FBX")) {
+        const auto unit_cm = metadata_any(scene, "UnitScaleFactor");
+        const auto up = metadata_any(scene, "UpAxis"), up_sign = metadata_any(scene, "UpAxisSign");
+        const std::string up_text = up ? std::string(", UpAxis ") + axis_name(*up, up_sign.value_or(1)) : std::string(", no UpAxis (Y taken)");
+        if (unit_cm && std::isfinite(*unit_cm) && *unit_cm > 0) {
+            out.metres_per_unit = *unit_cm * 0.01;
+            std::snprintf(text, sizeof text, "FBX: UnitScaleFactor %g (1 unit = %g cm)", *unit_cm, *unit_cm);
+            out.stated = text + up_text;
+        } else {
+            out.stated = "FBX: no UnitScaleFactor" + up_text;
+        }
+    } else {
+        out.stated = "the file states no unit";
+    }
+    return out;
 }
 
 struct Builder {
@@ -370,7 +411,9 @@ Result<void> build_mesh(Builder& b, MeshAsset& out, std::vector<MeshInfo>& infos
         sub.index_count = static_cast<std::uint32_t>(out.indices.size()) - sub.first_index;
         sub.color = material_color(scene, mesh);
         out.submeshes.push_back(sub);
-        infos.push_back({mesh_name, static_cast<std::uint32_t>(base), nv, mesh->mNumBones == 0 || any_rigid});
+        aiString material;
+        if (mesh->mMaterialIndex < scene->mNumMaterials) scene->mMaterials[mesh->mMaterialIndex]->Get(AI_MATKEY_NAME, material);
+        infos.push_back({mesh_name, static_cast<std::uint32_t>(base), nv, mesh->mNumBones == 0 || any_rigid, material.C_Str()});
         base += nv;
     }
     return {};
@@ -636,6 +679,8 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     if (!(raw_height > 0) || !std::isfinite(raw_height)) return fail(where(path) + ": the rest pose has no height (flat or degenerate mesh)");
     double scale = 1;
     ScaleSource source = ScaleSource::file_units;
+    const FileUnits units = file_units(scene, path);
+    std::string note = units.stated;
     if (options.scale) {
         scale = *options.scale;
         source = ScaleSource::option;
@@ -643,12 +688,24 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
         scale = *options.height_m / raw_height;
         source = ScaleSource::height;
     } else {
-        if (source_format_contains(scene, "FBX"))
-            if (auto unit_cm = metadata_any(scene, "UnitScaleFactor"); unit_cm && *unit_cm > 0) scale = *unit_cm * 0.01;
-        const double h = raw_height * scale;
-        if (h < options.min_plausible_height_m || h > options.max_plausible_height_m) {
+        char text[256];
+        if (units.metres_per_unit) {
+            scale = *units.metres_per_unit;
+            const double h = raw_height * scale;
+            if (h < options.min_plausible_height_m || h > options.max_plausible_height_m) {
+                // Some exporters state a unit their vertices do not use (the body would be
+                // hundreds of metres tall): a standard height is nearer the truth.
+                scale = options.fallback_height_m / raw_height;
+                source = ScaleSource::fallback;
+                std::snprintf(text, sizeof text, "; in that unit it is %.3g m tall, outside %.2g-%.2g m: scaled to %.2f m instead", h,
+                              options.min_plausible_height_m, options.max_plausible_height_m, options.fallback_height_m);
+                note += text;
+            }
+        } else {
             scale = options.fallback_height_m / raw_height;
             source = ScaleSource::fallback;
+            std::snprintf(text, sizeof text, "; scaled to the standard height %.2f m", options.fallback_height_m);
+            note += text;
         }
     }
     apply_root_correction(skeleton, *mesh, clips, Mat3::Identity(), static_cast<Real>(scale));
@@ -657,7 +714,10 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     for (std::size_t i = 0; i < bones; ++i)
         if (!finite(skeleton.inverse_bind[i]) || !finite(skeleton.rest_local[i]))
             return fail(where(path) + ": bone '" + skeleton.bone_names[i] + "' has a singular or non-finite transform");
-    for (auto& clip : clips) compute_clip_travel(*clip, skeleton);
+    for (auto& clip : clips) {
+        compute_clip_travel(*clip, skeleton);
+        blend_loop_seam(*clip);
+    }
 
     std::vector<bool> moves(bones, false);
     for (Eigen::Index j = 0; j < mesh->bone_weights.cols(); ++j)
@@ -668,6 +728,7 @@ Result<std::shared_ptr<const CharacterAsset>> import_character(const std::filesy
     asset->name = path.stem().string();
     asset->scale = scale;
     asset->scale_source = source;
+    asset->units_note = std::move(note);
     asset->height_m = rest_height(skeleton, *mesh);
     asset->skin_bones = static_cast<int>(std::count(moves.begin(), moves.end(), true));
     asset->warnings = std::move(b.warnings);
@@ -741,14 +802,32 @@ std::string says(const std::vector<std::string>& words, std::initializer_list<st
     return {};
 }
 
-// Every channel's last rotation key within about 6 degrees of its first: the clip loops.
-bool loops(const AnimationClip& clip) {
+}  // namespace
+
+Real loop_mismatch_rad(const AnimationClip& clip) noexcept {
+    Real worst = 0;
     for (const BoneChannel& ch : clip.channels)
-        if (ch.rotations.size() >= 2 && ch.rotations.front().angularDistance(ch.rotations.back()) > Real(0.1)) return false;
-    return !clip.channels.empty();
+        if (ch.rotations.size() >= 2) worst = std::max(worst, ch.rotations.front().angularDistance(ch.rotations.back()));
+    return worst;
 }
 
-}  // namespace
+bool clip_loops(const AnimationClip& clip) noexcept {
+    return !clip.channels.empty() && loop_mismatch_rad(clip) <= near_loop_tolerance_rad;
+}
+
+void blend_loop_seam(AnimationClip& clip) noexcept {
+    clip.seam_blend_s = 0;
+    if (!(clip.duration_s > 0) || !clip_loops(clip)) return;
+    // Ends within a hundredth of a degree (and a micrometre) are on each other already.
+    bool apart = loop_mismatch_rad(clip) > Real(2e-4);
+    for (const BoneChannel& ch : clip.channels)
+        if (ch.positions.size() >= 2) {
+            Vec3 gap = ch.positions.front() - ch.positions.back();
+            if (ch.bone == clip.motion_bone) gap += clip.travel_local;  // the travel is the cycle's, not a seam
+            apart = apart || gap.norm() > Real(1e-6);
+        }
+    if (apart) clip.seam_blend_s = std::min(0.2, 0.2 * clip.duration_s);
+}
 
 std::optional<ClipChoice> choose_default_clip(const CharacterAsset& character) {
     if (character.clips.empty()) return std::nullopt;
@@ -772,7 +851,7 @@ std::optional<ClipChoice> choose_default_clip(const CharacterAsset& character) {
             const std::vector<std::string> words = clip_words(clip.name);
             const std::string word = says(words, kind.stems);
             if (word.empty()) continue;
-            const bool looping = loops(clip);
+            const bool looping = clip_loops(clip);
             if (kind.must_loop && !looping) continue;
             const int rank = (says(words, other_actions).empty() ? 2 : 0) + (looping ? 1 : 0);
             if (!best || rank > best_rank) {
@@ -781,9 +860,9 @@ std::optional<ClipChoice> choose_default_clip(const CharacterAsset& character) {
                 best_word = word;
             }
         }
-        if (best) return ClipChoice{*best, character.clips[*best]->name + " (" + kind.why + best_word + ")"};
+        if (best) return ClipChoice{*best, character.clips[*best]->name + " (" + kind.why + best_word + ")", !kind.must_loop && &kind != &kinds[0]};
     }
-    return ClipChoice{0, character.clips[0]->name + " (first clip: no walk, locomotion or idle clip)"};
+    return ClipChoice{0, character.clips[0]->name + " (first clip: no walk, locomotion or idle clip)", true};
 }
 
 }  // namespace drape

@@ -28,7 +28,16 @@ std::string json_escape(std::string_view s) {
 }
 }  // namespace
 
-FrameProfiler::FrameProfiler(std::size_t ring_capacity) : m_capacity(std::max<std::size_t>(ring_capacity, 16)) {}
+FrameProfiler::FrameProfiler(std::size_t ring_capacity)
+    : m_capacity(std::max<std::size_t>(ring_capacity, 16)), m_trace_capacity(m_capacity) {}
+
+void FrameProfiler::set_trace_capacity(std::size_t events) {
+    m_trace_capacity = std::max<std::size_t>(events, 16);
+    m_events.clear();
+    m_events.shrink_to_fit();
+    m_next_event = 0;
+    m_events_recorded = 0;
+}
 
 std::uint32_t FrameProfiler::add_slot(std::string name, std::uint32_t parent) {
     Slot slot;
@@ -46,11 +55,13 @@ void FrameProfiler::record_skip(std::uint32_t slot) noexcept {
 }
 
 void FrameProfiler::begin_frame() noexcept {
+    for (Slot& s : m_slots) s.frame_ms = 0;
     if (m_timing) m_frame_start = Clock::now();
 }
 
 void FrameProfiler::end_frame() noexcept {
     ++m_frames;
+    for (Slot& s : m_slots) s.last_frame_ms = s.frame_ms;
     if (!m_timing) return;
     const auto end = Clock::now();
     m_frame_total_ms += std::chrono::duration<double, std::milli>(end - m_frame_start).count();
@@ -62,6 +73,7 @@ void FrameProfiler::record_run(std::uint32_t slot, Clock::time_point start, Cloc
     const double ms = std::chrono::duration<double, std::milli>(end - start).count();
     ++s.runs;
     s.total_ms += ms;
+    s.frame_ms += ms;
     s.max_ms = std::max(s.max_ms, ms);
     if (s.recent_ms.size() < m_capacity) s.recent_ms.push_back(static_cast<float>(ms));
     else s.recent_ms[s.next] = static_cast<float>(ms);
@@ -69,13 +81,33 @@ void FrameProfiler::record_run(std::uint32_t slot, Clock::time_point start, Cloc
     push_event(slot, start, end);
 }
 
+std::uint32_t FrameProfiler::thread_index() noexcept {
+    const std::thread::id self = std::this_thread::get_id();
+    for (std::size_t i = 0; i < m_threads.size(); ++i)
+        if (m_threads[i] == self) return static_cast<std::uint32_t>(i);
+    try {
+        m_threads.push_back(self);
+    } catch (...) {
+        return 0;  // out of memory: counted with the first thread
+    }
+    return static_cast<std::uint32_t>(m_threads.size() - 1);
+}
+
 void FrameProfiler::push_event(std::uint32_t slot, Clock::time_point start, Clock::time_point end) noexcept {
-    TraceEvent ev{slot,
-                  std::chrono::duration_cast<std::chrono::microseconds>(start - m_origin).count(),
-                  std::chrono::duration_cast<std::chrono::microseconds>(end - start).count()};
-    if (m_events.size() < m_capacity) m_events.push_back(ev);
-    else m_events[m_next_event] = ev;
-    m_next_event = (m_next_event + 1) % m_capacity;
+    const TraceEvent ev{slot, slot == frame_slot ? 0u : thread_index(),
+                        std::chrono::duration_cast<std::chrono::nanoseconds>(start - m_origin).count(),
+                        std::chrono::duration_cast<std::chrono::nanoseconds>(end - start).count()};
+    ++m_events_recorded;
+    if (m_events.size() < m_trace_capacity) {
+        try {
+            m_events.push_back(ev);
+        } catch (...) {
+            return;  // out of memory: the event is dropped, and counted so
+        }
+    } else {
+        m_events[m_next_event] = ev;
+    }
+    m_next_event = (m_next_event + 1) % m_trace_capacity;
 }
 
 double FrameProfiler::mean_frame_ms() const noexcept {
@@ -105,7 +137,9 @@ std::vector<SystemStats> FrameProfiler::stats() const {
 SystemStats FrameProfiler::stats(std::string_view name) const {
     for (SystemStats& s : stats())
         if (s.name == name) return s;
-    return SystemStats{std::string(name)};
+    SystemStats none;
+    none.name = std::string(name);
+    return none;
 }
 
 std::string FrameProfiler::table() const {
@@ -130,17 +164,30 @@ std::string FrameProfiler::table() const {
 Result<void> FrameProfiler::write_trace(const std::filesystem::path& file) const {
     std::ofstream os(file, std::ios::binary | std::ios::trunc);
     if (!os) return fail(file.string() + ": cannot open the trace file for writing");
-    os << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[";
-    // Oldest first: the ring's order starts at m_next_event once it has wrapped.
     const std::size_t n = m_events.size();
-    const std::size_t first = n < m_capacity ? 0 : m_next_event;
+    os << "{\"displayTimeUnit\":\"ms\",\"otherData\":{\"recorded_events\":" << m_events_recorded
+       << ",\"kept_events\":" << n << ",\"dropped_events\":" << trace_events_dropped()
+       << ",\"trace_capacity\":" << m_trace_capacity << "},\"traceEvents\":[";
+    // Tracks: tid 1 the frames, tid 2 + i the i-th thread that ran a system.
+    auto name_thread = [&](int tid, const std::string& name) {
+        os << ",\n{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":" << tid << ",\"args\":{\"name\":\""
+           << json_escape(name) << "\"}},\n{\"name\":\"thread_sort_index\",\"ph\":\"M\",\"pid\":1,\"tid\":" << tid
+           << ",\"args\":{\"sort_index\":" << tid << "}}";
+    };
+    os << "\n{\"name\":\"process_name\",\"ph\":\"M\",\"pid\":1,\"tid\":0,\"args\":{\"name\":\"drape\"}}";
+    name_thread(1, "frames");
+    for (std::size_t i = 0; i < m_threads.size(); ++i) name_thread(static_cast<int>(i) + 2, i == 0 ? "scheduler" : "thread " + std::to_string(i + 1));
+    // Oldest first: the ring's order starts at m_next_event once it has wrapped.
+    const std::size_t first = n < m_trace_capacity ? 0 : m_next_event;
+    char times[96];
     for (std::size_t k = 0; k < n; ++k) {
         const TraceEvent& ev = m_events[(first + k) % n];
         const bool is_frame = ev.slot == frame_slot;
-        os << (k ? ",\n" : "\n") << "{\"name\":\""
-           << (is_frame ? std::string("frame") : json_escape(m_slots[ev.slot].name))
-           << "\",\"cat\":\"" << (is_frame ? "frame" : "system") << "\",\"ph\":\"X\",\"ts\":" << ev.start_us
-           << ",\"dur\":" << ev.duration_us << ",\"pid\":1,\"tid\":" << (is_frame ? 1 : 2) << "}";
+        std::snprintf(times, sizeof times, "\"ts\":%.3f,\"dur\":%.3f", static_cast<double>(ev.start_ns) / 1000.0,
+                      static_cast<double>(ev.duration_ns) / 1000.0);
+        os << ",\n{\"name\":\"" << (is_frame ? std::string("frame") : json_escape(m_slots[ev.slot].name))
+           << "\",\"cat\":\"" << (is_frame ? "frame" : "system") << "\",\"ph\":\"X\"," << times
+           << ",\"pid\":1,\"tid\":" << (is_frame ? 1 : static_cast<int>(ev.thread) + 2) << "}";
     }
     os << "\n]}\n";
     if (!os) return fail(file.string() + ": write failed");
@@ -151,11 +198,13 @@ void FrameProfiler::reset() noexcept {
     for (Slot& s : m_slots) {
         s.runs = s.skips = 0;
         s.total_ms = s.max_ms = 0;
+        s.frame_ms = s.last_frame_ms = 0;
         s.recent_ms.clear();
         s.next = 0;
     }
     m_events.clear();
     m_next_event = 0;
+    m_events_recorded = 0;
     m_frames = 0;
     m_frame_total_ms = 0;
 }

@@ -275,6 +275,13 @@ public:
         return View<Ts...>(std::tuple<Pool<Ts>*...>(find_pool<Ts>()...));
     }
 
+    /// Calls `f(Entity, const Ts&...)` for each entity with every component in Ts, read-only
+    /// (the view's iteration contract, without changes to the components).
+    template <class... Ts, class F>
+    void each(F&& f) const {
+        View<Ts...>(std::tuple<Pool<Ts>*...>(find_pool<Ts>()...)).each([&](Entity e, Ts&... c) { f(e, std::as_const(c)...); });
+    }
+
 private:
     template <class T>
     Pool<T>& pool() {

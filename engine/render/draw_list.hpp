@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "drape/engine/core/image.hpp"
 #include "drape/engine/core/math.hpp"
 
 namespace drape {
@@ -54,6 +55,11 @@ struct MeshDraw {
     std::span<const std::uint32_t> triangles;  ///< Three indices per triangle, counter-clockwise = front.
     Vec3 color = Vec3(0.8f, 0.7f, 0.6f);       ///< Linear RGB of the whole mesh when `ranges` is empty; clamped to [0, 1].
     std::vector<DrawRange> ranges;             ///< Parts of `triangles` in their own colours (only these are lit).
+    /// A base-colour texture (sRGB, repeated; row 0 at v = 1), its colour multiplying `color`,
+    /// mapped by `uvs` (one per position). Either null, or `uvs` of another count: untextured.
+    /// The renderer keeps the texture on the GPU while the same image is listed under the key.
+    const Image* texture = nullptr;
+    const Matrix2X* uvs = nullptr;
     SurfaceLook look;
     bool casts_shadow = true;                  ///< Flattened onto the ground along the key light.
     bool contact_shadow = false;               ///< A soft blob on the ground under its lowest quarter (a body's feet).

@@ -4,9 +4,7 @@
 #include <cstring>
 #include <string>
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#define STB_IMAGE_WRITE_STATIC
-#include <stb/stb_image_write.h>
+#include <stb/stb_image_write.h>  // compiled in Debian's libstb (Drape::stb)
 
 namespace drape {
 

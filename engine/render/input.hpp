@@ -16,6 +16,7 @@ enum class Action : std::uint8_t {
     toggle_ellipsoids,///< E: show or hide the collision ellipsoids.
     switch_model,     ///< M: simplified <-> classic garment model.
     reset,            ///< R: restart the scene.
+    toggle_hud,       ///< H: show or hide the frame budget overlay.
     quit,             ///< Q, Escape, or the window's close button.
 };
 
@@ -26,6 +27,7 @@ enum class Action : std::uint8_t {
         case Action::toggle_ellipsoids: return "toggle_ellipsoids";
         case Action::switch_model: return "switch_model";
         case Action::reset: return "reset";
+        case Action::toggle_hud: return "toggle_hud";
         case Action::quit: return "quit";
     }
     return "unknown";

@@ -23,8 +23,10 @@
 #include <unordered_map>
 #include <vector>
 
+#include "drape/engine/core/mesh_normals.hpp"
 #include "drape/engine/render/egl_context.hpp"
 #include "drape/engine/render/gl.hpp"
+#include "drape/engine/render/hud_layout.hpp"
 #include "drape/engine/render/shaders.hpp"
 #include "drape/engine/render/x11_window.hpp"
 
@@ -76,9 +78,10 @@ Mat4 planar_shadow_matrix(const Vec3& l, Real lift) {
 }
 
 /// Vertex array with positions (location 0) and normals (location 1), each a tightly
-/// packed float3 buffer, and an index buffer. Buffer sizes are fixed at creation.
+/// packed float3 buffer, an index buffer, and for a textured mesh its UVs (location 2,
+/// float2, uploaded once). Buffer sizes are fixed at creation.
 struct MeshBuffers {
-    GLuint vao = 0, positions = 0, normals = 0, indices = 0;
+    GLuint vao = 0, positions = 0, normals = 0, indices = 0, uvs = 0;
     GLsizei vertex_count = 0, index_count = 0;
 
     void create(GLsizei vertices, const std::uint32_t* index_data, GLsizei indices_count) {
@@ -101,6 +104,17 @@ struct MeshBuffers {
         }
         glVertexArrayElementBuffer(vao, indices);
     }
+    void set_uvs(const Matrix2X& uv) {
+        if (uvs == 0) {
+            glCreateBuffers(1, &uvs);
+            glNamedBufferData(uvs, GLsizeiptr(vertex_count) * 2 * GLsizeiptr(sizeof(float)), nullptr, GL_STATIC_DRAW);
+            glVertexArrayVertexBuffer(vao, 2, uvs, 0, 2 * sizeof(float));
+            glEnableVertexArrayAttrib(vao, 2);
+            glVertexArrayAttribFormat(vao, 2, 2, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, 2, 2);
+        }
+        glNamedBufferSubData(uvs, 0, GLsizeiptr(vertex_count) * 2 * GLsizeiptr(sizeof(float)), uv.data());
+    }
     void upload(const Matrix3X& p, const Matrix3X& n) const {
         const GLsizeiptr bytes = GLsizeiptr(vertex_count) * 3 * GLsizeiptr(sizeof(float));
         glNamedBufferSubData(positions, 0, bytes, p.data());
@@ -108,28 +122,11 @@ struct MeshBuffers {
     }
     void destroy() {
         if (vao != 0) glDeleteVertexArrays(1, &vao);
-        const GLuint buffers[3] = {positions, normals, indices};
-        glDeleteBuffers(3, buffers);
+        const GLuint buffers[4] = {positions, normals, indices, uvs};
+        glDeleteBuffers(4, buffers);
         *this = {};
     }
 };
-
-/// Area-weighted vertex normals of a triangle list (counter-clockwise = front).
-void compute_normals(const Matrix3X& x, std::span<const std::uint32_t> triangles, Matrix3X& normals) {
-    normals.setZero(3, x.cols());
-    for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
-        const auto a = triangles[t], b = triangles[t + 1], c = triangles[t + 2];
-        const Vec3 face = (x.col(b) - x.col(a)).cross(x.col(c) - x.col(a));
-        normals.col(a) += face;
-        normals.col(b) += face;
-        normals.col(c) += face;
-    }
-    for (Eigen::Index i = 0; i < normals.cols(); ++i) {
-        const Real length = normals.col(i).norm();
-        if (length > Real(1e-20) && std::isfinite(length)) normals.col(i) /= length;
-        else normals.col(i) = Vec3::UnitY();
-    }
-}
 
 /// First index that is out of range, or -1.
 long long first_bad_index(std::span<const std::uint32_t> indices, std::size_t vertex_count) {
@@ -152,9 +149,13 @@ struct Renderer::Impl {
     GLuint draw_fbo = 0, draw_color = 0, draw_depth = 0;
     GLuint resolve_fbo = 0, resolve_color = 0;
     GLuint empty_vao = 0;
-    GLuint lit = 0, ground = 0, blob = 0, shadow = 0;
+    GLuint lit = 0, ground = 0, blob = 0, shadow = 0, hud = 0;
+    GLint hud_frame_size = -1;
+    GLuint hud_vao = 0, hud_buffer = 0;
+    GLsizeiptr hud_buffer_bytes = 0;
+    std::vector<render_detail::HudVertex> hud_vertices;  // scratch
     struct {
-        GLint view_projection, model, normal_matrix, color, eye, two_sided, specular, shininess, rim;
+        GLint view_projection, model, normal_matrix, color, eye, two_sided, specular, shininess, rim, textured, base_color;
     } lit_u{};
     struct {
         GLint view_projection, center, half_size, sky, albedo;
@@ -173,6 +174,9 @@ struct Renderer::Impl {
         const std::uint32_t* triangles = nullptr;  // the index data the buffers hold; null: nothing valid
         std::size_t index_count = 0;
         Matrix3X computed_normals;                 // when the mesh comes without normals
+        const Matrix2X* uvs = nullptr;             // the UVs the buffers hold; null: none
+        GLuint texture = 0;                        // the base-colour texture on the GPU; 0: none
+        const Image* texture_image = nullptr;      // the image it was made from
         std::uint64_t seen = 0;                    // the last frame that listed it
     };
     /// A listed mesh whose buffers are valid and uploaded this frame.
@@ -198,18 +202,30 @@ struct Renderer::Impl {
 
     ~Impl() {
         if (!context || !context->make_current()) return;
-        for (auto& [key, entry] : meshes) entry.buffers.destroy();
+        for (auto& [key, entry] : meshes) destroy(entry);
         sphere.destroy();
         glDeleteProgram(lit);
         glDeleteProgram(ground);
         glDeleteProgram(shadow);
         glDeleteProgram(blob);
+        glDeleteProgram(hud);
+        glDeleteBuffers(1, &hud_buffer);
+        glDeleteVertexArrays(1, &hud_vao);
         glDeleteVertexArrays(1, &empty_vao);
         const GLuint fbos[2] = {draw_fbo, resolve_fbo};
         glDeleteFramebuffers(2, fbos);
         const GLuint rbs[3] = {draw_color, draw_depth, resolve_color};
         glDeleteRenderbuffers(3, rbs);
     }
+
+    static void destroy(MeshEntry& entry) {
+        entry.buffers.destroy();
+        if (entry.texture != 0) glDeleteTextures(1, &entry.texture);
+        entry.texture = 0;
+        entry.texture_image = nullptr;
+        entry.uvs = nullptr;
+    }
+    void prepare_texture(const MeshDraw& mesh, MeshEntry& entry);
 
     void note(std::string message) {
         if (frame_error.empty()) frame_error = std::move(message);
@@ -232,6 +248,7 @@ struct Renderer::Impl {
     void draw_lit_meshes(const FrameView& view);
     void draw_ellipsoids(const FrameView& view, const DrawList& list);
     void resolve();
+    void draw_hud(const HudOverlay& overlay);
     GLuint read_fbo() const { return resolve_fbo != 0 ? resolve_fbo : draw_fbo; }
 };
 
@@ -289,9 +306,23 @@ Result<void> Renderer::Impl::create_programs() {
     auto b = render_detail::build_program("blob", render_detail::blob_vertex_shader, render_detail::blob_fragment_shader);
     if (!b) return fail(b.error().message);
     blob = *b;
+    auto h = render_detail::build_program("hud", render_detail::hud_vertex_shader, render_detail::hud_fragment_shader);
+    if (!h) return fail(h.error().message);
+    hud = *h;
     auto at = [](GLuint p, const char* n) { return glGetUniformLocation(p, n); };
+    hud_frame_size = at(hud, "u_frame_size");
+    glCreateVertexArrays(1, &hud_vao);
+    glCreateBuffers(1, &hud_buffer);
+    glVertexArrayVertexBuffer(hud_vao, 0, hud_buffer, 0, sizeof(render_detail::HudVertex));
+    glEnableVertexArrayAttrib(hud_vao, 0);
+    glVertexArrayAttribFormat(hud_vao, 0, 2, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(hud_vao, 0, 0);
+    glEnableVertexArrayAttrib(hud_vao, 1);
+    glVertexArrayAttribFormat(hud_vao, 1, 4, GL_FLOAT, GL_FALSE, 2 * sizeof(float));
+    glVertexArrayAttribBinding(hud_vao, 1, 0);
     lit_u = {at(lit, "u_view_projection"), at(lit, "u_model"), at(lit, "u_normal_matrix"), at(lit, "u_color"),
-             at(lit, "u_eye"), at(lit, "u_two_sided"), at(lit, "u_specular"), at(lit, "u_shininess"), at(lit, "u_rim")};
+             at(lit, "u_eye"), at(lit, "u_two_sided"), at(lit, "u_specular"), at(lit, "u_shininess"), at(lit, "u_rim"),
+             at(lit, "u_textured"), at(lit, "u_base_color")};
     ground_u = {at(ground, "u_view_projection"), at(ground, "u_center"), at(ground, "u_half_size"),
                 at(ground, "u_sky"), at(ground, "u_albedo")};
     blob_u = {at(blob, "u_view_projection"), at(blob, "u_blob")};
@@ -353,9 +384,10 @@ void Renderer::Impl::upload_meshes(const DrawList& list) {
         if (mesh.normals != nullptr && mesh.normals->cols() == positions.cols()) {
             entry.buffers.upload(positions, *mesh.normals);
         } else {
-            compute_normals(positions, mesh.triangles, entry.computed_normals);
+            vertex_normals(positions, mesh.triangles, entry.computed_normals);
             entry.buffers.upload(positions, entry.computed_normals);
         }
+        prepare_texture(mesh, entry);
         ready.push_back({&mesh, &entry});
     }
 }
@@ -366,7 +398,7 @@ bool Renderer::Impl::prepare_buffers(const MeshDraw& mesh, MeshEntry& entry) {
     const Eigen::Index vertices = mesh.positions->cols();
     if (entry.triangles != mesh.triangles.data() || entry.index_count != mesh.triangles.size() ||
         entry.buffers.vertex_count != vertices) {
-        entry.buffers.destroy();
+        destroy(entry);
         entry.triangles = nullptr;
         entry.index_count = 0;
         if (mesh.triangles.size() % 3 != 0) {
@@ -388,6 +420,41 @@ bool Renderer::Impl::prepare_buffers(const MeshDraw& mesh, MeshEntry& entry) {
             return false;
         }
     return true;
+}
+
+// A textured mesh's UVs (uploaded when they are new to the buffers) and its texture (made
+// when the image is new to the key: sRGB, mipmapped, repeated). A texture of a bad size, or
+// UVs of another count, draw the mesh untextured and say so.
+void Renderer::Impl::prepare_texture(const MeshDraw& mesh, MeshEntry& entry) {
+    if (mesh.texture == nullptr || mesh.uvs == nullptr) return;
+    if (mesh.uvs->cols() != mesh.positions->cols()) {
+        note(mesh.name + ": " + std::to_string(mesh.uvs->cols()) + " UVs for " + std::to_string(mesh.positions->cols()) + " vertices (drawn untextured)");
+        return;
+    }
+    if (mesh.texture->empty() || mesh.texture->rgba.size() != std::size_t(mesh.texture->width) * std::size_t(mesh.texture->height) * 4) {
+        note(mesh.name + ": its texture's pixels do not match its size " + std::to_string(mesh.texture->width) + "x" +
+             std::to_string(mesh.texture->height) + " (drawn untextured)");
+        return;
+    }
+    if (entry.uvs != mesh.uvs) {
+        entry.buffers.set_uvs(*mesh.uvs);
+        entry.uvs = mesh.uvs;
+    }
+    if (entry.texture_image == mesh.texture && entry.texture != 0) return;
+    if (entry.texture != 0) glDeleteTextures(1, &entry.texture);
+    const Image& image = *mesh.texture;
+    int levels = 1;
+    while ((std::max(image.width, image.height) >> levels) > 0) ++levels;
+    glCreateTextures(GL_TEXTURE_2D, 1, &entry.texture);
+    glTextureStorage2D(entry.texture, levels, GL_SRGB8_ALPHA8, image.width, image.height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage2D(entry.texture, 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+    glGenerateTextureMipmap(entry.texture);
+    glTextureParameteri(entry.texture, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(entry.texture, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glTextureParameteri(entry.texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(entry.texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    entry.texture_image = mesh.texture;
 }
 
 // Contact shadow: a soft blob under the footprint of a body's lowest quarter (the feet and
@@ -422,7 +489,7 @@ void Renderer::Impl::free_unlisted_buffers() {
     for (auto& [key, entry] : meshes)
         if (entry.seen != frame) stale.push_back(key);
     for (const DrawKey& key : stale) {
-        meshes[key].buffers.destroy();
+        destroy(meshes[key]);
         meshes.erase(key);
     }
 }
@@ -496,12 +563,16 @@ void Renderer::Impl::draw_lit_meshes(const FrameView& view) {
     glUniformMatrix4fv(lit_u.model, 1, GL_FALSE, identity.data());
     glUniformMatrix3fv(lit_u.normal_matrix, 1, GL_FALSE, identity3.data());
     glUniform3fv(lit_u.eye, 1, view.eye.data());
+    glUniform1i(lit_u.base_color, 0);  // texture unit 0
     for (const ReadyMesh& r : ready) {
         const MeshDraw& mesh = *r.mesh;
         glUniform1i(lit_u.two_sided, mesh.look.two_sided ? 1 : 0);
         glUniform1f(lit_u.specular, mesh.look.specular);
         glUniform1f(lit_u.shininess, mesh.look.shininess);
         glUniform1f(lit_u.rim, mesh.look.rim);
+        const bool textured = r.entry->texture != 0 && r.entry->texture_image == mesh.texture && mesh.uvs == r.entry->uvs;
+        glUniform1i(lit_u.textured, textured ? 1 : 0);
+        if (textured) glBindTextureUnit(0, r.entry->texture);
         glBindVertexArray(r.entry->buffers.vao);
         if (mesh.ranges.empty()) {
             const Vec3 c = clamp01(mesh.color);
@@ -562,6 +633,36 @@ void Renderer::Impl::resolve() {
         }() + " while drawing the frame");
 }
 
+// The overlay goes onto the frame read_pixels() and present() use (after the resolve, so
+// it is drawn once, without multisampling), blended, with no depth test. The vertex
+// buffer grows when needed and is otherwise rewritten in place.
+void Renderer::Impl::draw_hud(const HudOverlay& overlay) {
+    render_detail::layout_hud(overlay, settings.width, settings.height, hud_vertices);
+    if (hud_vertices.empty()) return;
+    const auto bytes = GLsizeiptr(hud_vertices.size() * sizeof(render_detail::HudVertex));
+    if (bytes > hud_buffer_bytes) {
+        hud_buffer_bytes = std::max(bytes, GLsizeiptr(64 * 1024));
+        glNamedBufferData(hud_buffer, hud_buffer_bytes, nullptr, GL_DYNAMIC_DRAW);
+    }
+    glNamedBufferSubData(hud_buffer, 0, bytes, hud_vertices.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, read_fbo());
+    glViewport(0, 0, settings.width, settings.height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_STENCIL_TEST);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(hud);
+    glUniform2f(hud_frame_size, float(settings.width), float(settings.height));
+    glBindVertexArray(hud_vao);
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(hud_vertices.size()));
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+    if (const GLenum error = glGetError(); error != GL_NO_ERROR)
+        note("OpenGL error " + std::to_string(error) + " while drawing the overlay");
+}
+
 // ---------------------------------------------------------------------------------------
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
@@ -619,6 +720,19 @@ void Renderer::draw(const DrawList& list) {
         return;
     }
     m_impl->draw(list);
+}
+
+void Renderer::draw_hud(const HudOverlay& hud) {
+    if (!m_impl->drawn) return;
+    if (!m_impl->context->make_current()) {
+        m_impl->frame_error = "EGL: cannot make the renderer's context current";
+        return;
+    }
+    m_impl->draw_hud(hud);
+}
+
+void Renderer::set_window_title(const std::string& title) {
+    if (m_impl->window) m_impl->window->set_title(title);
 }
 
 Result<void> Renderer::read_pixels(Image& into) {

@@ -21,6 +21,7 @@
 #include "drape/engine/core/math.hpp"
 #include "drape/engine/render/camera.hpp"
 #include "drape/engine/render/draw_list.hpp"
+#include "drape/engine/render/hud.hpp"
 #include "drape/engine/render/image.hpp"
 #include "drape/engine/render/input.hpp"
 
@@ -81,6 +82,13 @@ public:
     /// triangles) skips that mesh; it and the list's own problems are reported by the next
     /// read_pixels()/present().
     void draw(const DrawList& list);
+
+    /// Draws the heads-up overlay (engine/render/hud.hpp) over the last drawn frame, in its
+    /// top-left corner; read_pixels() and present() then show it. Call after draw().
+    void draw_hud(const HudOverlay& hud);
+
+    /// Window: replaces the window's title. Off-screen: does nothing.
+    void set_window_title(const std::string& title);
 
     /// The last drawn frame, RGBA8, top row first. Also reports an error of the last draw.
     [[nodiscard]] Result<Image> read_pixels();

@@ -24,15 +24,18 @@ namespace drape::render_detail {
 const char* const lit_vertex_shader = R"(#version 450 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view_projection;
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 out vec3 v_world;
 out vec3 v_normal;
+out vec2 v_uv;
 void main() {
     vec4 world = u_model * vec4(a_position, 1.0);
     v_world = world.xyz;
     v_normal = u_normal_matrix * a_normal;
+    v_uv = a_uv;
     gl_Position = u_view_projection * world;
 }
 )";
@@ -40,7 +43,10 @@ void main() {
 const char* const lit_fragment_shader = "#version 450 core\n" DRAPE_GLSL_LIGHTS R"(
 in vec3 v_world;
 in vec3 v_normal;
+in vec2 v_uv;
 uniform vec4 u_color;        // linear RGB, alpha
+uniform int u_textured;      // u_base_color (sRGB, decoded to linear by the sampler) times u_color
+uniform sampler2D u_base_color;
 uniform vec3 u_eye;
 uniform int u_two_sided;     // back faces lit with the flipped normal
 uniform float u_specular;
@@ -60,6 +66,7 @@ void main() {
     float facing = 1.0 - max(dot(n, v), 0.0);
     float rim = facing * facing * facing * u_rim;
     vec3 albedo = u_color.rgb;
+    if (u_textured != 0) albedo *= texture(u_base_color, vec2(v_uv.x, 1.0 - v_uv.y)).rgb;  // row 0 at v = 1
     vec3 color = albedo * (key_color * key + fill_color * fill + ambient) + key_color * spec + sky_color * rim;
     o_color = vec4(tone(color), u_color.a);
 }
@@ -134,6 +141,23 @@ const char* const shadow_fragment_shader = R"(#version 450 core
 uniform float u_darkness;
 out vec4 o_color;
 void main() { o_color = vec4(0.0, 0.0, 0.0, u_darkness); }
+)";
+
+const char* const hud_vertex_shader = R"(#version 450 core
+layout(location = 0) in vec2 a_pixel;
+layout(location = 1) in vec4 a_color;
+uniform vec2 u_frame_size;   // px
+out vec4 v_color;
+void main() {
+    v_color = a_color;
+    gl_Position = vec4(a_pixel.x / u_frame_size.x * 2.0 - 1.0, 1.0 - a_pixel.y / u_frame_size.y * 2.0, 0.0, 1.0);
+}
+)";
+
+const char* const hud_fragment_shader = R"(#version 450 core
+in vec4 v_color;
+out vec4 o_color;
+void main() { o_color = v_color; }
 )";
 
 namespace {

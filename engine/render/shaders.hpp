@@ -20,6 +20,9 @@ extern const char* const blob_fragment_shader;
 /// Planar projected shadows onto the ground.
 extern const char* const shadow_vertex_shader;
 extern const char* const shadow_fragment_shader;
+/// The heads-up overlay: 2D triangles in pixels (top-left origin) with a colour each.
+extern const char* const hud_vertex_shader;
+extern const char* const hud_fragment_shader;
 
 /// Compiles and links a program; the error names the program, the stage and the GL log.
 [[nodiscard]] Result<GLuint> build_program(std::string_view name, const char* vertex_source,

@@ -69,6 +69,7 @@ bool X11Window::poll(InputState& input) {
                     case XK_e: input.actions.push_back(Action::toggle_ellipsoids); break;
                     case XK_m: input.actions.push_back(Action::switch_model); break;
                     case XK_r: input.actions.push_back(Action::reset); break;
+                    case XK_h: input.actions.push_back(Action::toggle_hud); break;
                     case XK_q:
                     case XK_Escape: input.actions.push_back(Action::quit); break;
                     default: break;
@@ -123,5 +124,11 @@ bool X11Window::poll(InputState& input) {
 }
 
 #endif
+
+void X11Window::set_title(const std::string& title) {
+    auto* display = static_cast<Display*>(m_display);
+    XStoreName(display, m_window, title.c_str());
+    XFlush(display);
+}
 
 }  // namespace drape::render_detail

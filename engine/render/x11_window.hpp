@@ -22,6 +22,8 @@ public:
 
     /// Drains pending events into `input` (actions, drag and wheel). False once closed.
     bool poll(InputState& input);
+    /// Replaces the title the window manager shows.
+    void set_title(const std::string& title);
 
 private:
     X11Window() = default;

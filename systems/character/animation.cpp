@@ -23,7 +23,7 @@ void advance_animation(AnimationPlayer& player, Skeleton& skeleton, Transform* t
             player.cycles += t.cycles;
             player.time_s = t.time_s;
         }
-        sample_clip(*player.clip, asset, player.time_s, player.in_place, skeleton.local);  // a one-key clip is a pose
+        sample_clip(*player.clip, asset, player.time_s, player.in_place, skeleton.local, player.loop);  // a one-key clip is a pose
     } else {
         rest_pose(asset, skeleton.local);
     }

@@ -33,9 +33,9 @@ static_assert(sizeof(FitOptions) == 88, "body_cache.cpp: add the new FitOptions 
 static_assert(sizeof(EllipsoidShape) == 64, "body_cache.cpp: write and read the new EllipsoidShape field");
 static_assert(sizeof(BodyPoint) == 28, "body_cache.cpp: write and read the new BodyPoint field");
 static_assert(sizeof(BodySection) == 40, "body_cache.cpp: write and read the new BodySection field");
-static_assert(sizeof(BodyLandmarks) == 408, "body_cache.cpp: write and read the new BodyLandmarks field");
-static_assert(sizeof(CharacterBody) == 480, "body_cache.cpp: write and read the new CharacterBody field");
-constexpr std::string_view magic = "drape fitted body 1\n";
+static_assert(sizeof(BodyLandmarks) == 432, "body_cache.cpp: write and read the new BodyLandmarks field");
+static_assert(sizeof(CharacterBody) == 528, "body_cache.cpp: write and read the new CharacterBody field");
+constexpr std::string_view magic = "drape fitted body 2\n";
 constexpr std::size_t encoded_ellipsoid_bytes = 4 + 12 + 16 + 12 + 1 + 4;  // as body_fields() lists one
 
 std::string number(double v) {
@@ -190,8 +190,17 @@ void body_fields(Io& io, Body& body) {
         point(io, l.left_shoulder);
         point(io, l.right_shoulder);
         io.text(l.found_by);
+        io.items(l.how_found, 2 * sizeof(std::uint32_t), [&](auto& how) {
+            io.text(how.first);
+            io.text(how.second);
+        });
     });
     io.text(body.landmarks_error);
+    io.items(body.left_out, sizeof(std::size_t) + 1 + sizeof(std::uint32_t), [&](auto& m) {
+        io.raw(m.mesh);
+        io.raw(m.garment);
+        io.text(m.why);
+    });
 }
 
 std::string encode(const CharacterBody& body) {

@@ -114,7 +114,8 @@ struct Cut {
 
 // The section of the skin of `bones` (a mask) at height `y`.
 Cut section(const Rig& rig, const std::vector<std::uint32_t>& indices, const std::vector<char>& bones, Real y,
-            const Vec3& left, const Vec3& forward) {
+            const Vec3& left, const Vec3& forward, Real left_min = -std::numeric_limits<Real>::infinity(),
+            Real left_max = std::numeric_limits<Real>::infinity()) {
     std::vector<Vec2d> points;  // (left, forward) coordinates
     for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
         const std::uint32_t v[3] = {indices[t], indices[t + 1], indices[t + 2]};
@@ -126,6 +127,7 @@ Cut section(const Rig& rig, const std::vector<std::uint32_t>& indices, const std
             if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
             const Real s = (y - a.y()) / (b.y() - a.y());
             const Vec3 p = a + s * (b - a);
+            if (p.dot(left) < left_min || p.dot(left) > left_max) continue;  // beyond the armpits: an arm
             points.emplace_back(double(p.dot(left)), double(p.dot(forward)));
         }
     }
@@ -328,19 +330,40 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
     for (int leg : legs) trunk_and_thighs[static_cast<std::size_t>(follow_chain(rig, leg, true).root)] = 1;
     for (int leg : legs) trunk_and_thighs[static_cast<std::size_t>(leg)] = 1;
 
-    // Crotch: the lowest skin of the pelvis bone near the midplane.
+    // Crotch: where the legs part, the lowest point at which the midplane between the two
+    // thighs' joints still cuts the skin, within the trunk's depth, above the knees (whatever
+    // bone the skin there follows: in many rigs it is a thigh's). Else the lowest skin of the
+    // pelvis bone near the midplane; else under the pelvis joint.
     Real crotch = std::numeric_limits<Real>::infinity();
-    for (Eigen::Index v = 0; v < rig.positions.cols(); ++v) {
-        if (rig.owner[static_cast<std::size_t>(v)] != pelvis) continue;
-        if (std::abs((Vec3(rig.positions.col(v)) - axis).dot(out.left)) > Real(0.02) * h) continue;
-        crotch = std::min(crotch, rig.positions(1, v));
+    const Vec3 between = Real(0.5) * (joint(rig, out.left_leg.root) + joint(rig, out.right_leg.root));
+    const Real knees = std::max(out.left_leg.middle >= 0 ? joint(rig, out.left_leg.middle).y() : -std::numeric_limits<Real>::infinity(),
+                                out.right_leg.middle >= 0 ? joint(rig, out.right_leg.middle).y() : -std::numeric_limits<Real>::infinity());
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+        for (std::size_t e = 0; e < 3; ++e) {
+            const Vec3 a = rig.positions.col(mesh.indices[t + e]), b = rig.positions.col(mesh.indices[t + (e + 1) % 3]);
+            const Real sa = (a - between).dot(out.left), sb = (b - between).dot(out.left);
+            if (!(sa * sb < 0)) continue;
+            const Vec3 q = a + (b - a) * (sa / (sa - sb));
+            if (q.y() > knees + Real(0.02) * h && std::abs((q - between).dot(out.forward)) < Real(0.15) * h) crotch = std::min(crotch, q.y());
+        }
+    const bool crotch_parted = std::isfinite(crotch) && crotch < joint(rig, pelvis).y() + Real(0.1) * h;
+    bool crotch_on_skin = false;
+    if (!crotch_parted) {
+        crotch = std::numeric_limits<Real>::infinity();
+        for (Eigen::Index v = 0; v < rig.positions.cols(); ++v) {
+            if (rig.owner[static_cast<std::size_t>(v)] != pelvis) continue;
+            if (std::abs((Vec3(rig.positions.col(v)) - axis).dot(out.left)) > Real(0.02) * h) continue;
+            crotch = std::min(crotch, rig.positions(1, v));
+        }
+        crotch_on_skin = std::isfinite(crotch) && crotch <= joint(rig, pelvis).y();
+        if (!crotch_on_skin) crotch = joint(rig, pelvis).y() - Real(0.05) * h;
     }
-    if (!std::isfinite(crotch) || crotch > joint(rig, pelvis).y()) crotch = joint(rig, pelvis).y() - Real(0.05) * h;
     out.crotch_m = crotch;
 
     // Armpits: the lowest arm skin on a triangle shared with the trunk.
     const std::vector<std::uint32_t>& indices = mesh.indices;
     std::array<Real, 2> armpit{std::numeric_limits<Real>::infinity(), std::numeric_limits<Real>::infinity()};
+    std::array<Real, 2> armpit_side{0, 0};  // along `left`: where each armpit is across the body
     for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
         bool touches_trunk = false;
         for (int e = 0; e < 3; ++e) touches_trunk = touches_trunk || trunk[static_cast<std::size_t>(rig.owner[indices[t + static_cast<std::size_t>(e)]])];
@@ -350,13 +373,18 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
             const int o = rig.owner[v];
             if (!arm[static_cast<std::size_t>(o)]) continue;
             const int s = in_subtree(rig, o, arms[0]) ? 0 : 1;
-            armpit[static_cast<std::size_t>(s)] = std::min(armpit[static_cast<std::size_t>(s)], rig.positions(1, v));
+            if (rig.positions(1, v) < armpit[static_cast<std::size_t>(s)]) {
+                armpit[static_cast<std::size_t>(s)] = rig.positions(1, v);
+                armpit_side[static_cast<std::size_t>(s)] = Vec3(rig.positions.col(v)).dot(out.left);
+            }
         }
     }
+    int armpits_on_skin = 0;
     for (int s = 0; s < 2; ++s) {
         const Real shoulder = joint(rig, (s == 0 ? out.left_arm : out.right_arm).root).y();
         Real& a = armpit[static_cast<std::size_t>(s)];
         if (!std::isfinite(a) || a > shoulder || a < shoulder - Real(0.15) * h) a = shoulder - Real(0.06) * h;
+        else ++armpits_on_skin;
     }
     out.underarm_m = Real(0.5) * (armpit[0] + armpit[1]);
     out.left_shoulder = body_point(rig, out.left_arm.root, joint(rig, out.left_arm.root));
@@ -388,12 +416,45 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
     const Cut waist = extreme(trunk_and_thighs, crotch + Real(0.3) * span, crotch + Real(0.8) * span, true);
     if (!waist.valid) return fail(at + "the trunk's skin has no section between crotch and armpits");
     const Cut hips = extreme(trunk_and_thighs, crotch, waist.center.y(), false);
-    const Cut chest = extreme(trunk, waist.center.y(), out.underarm_m, false);
+    // The chest: the trunk, and the skin of the arms' first bones (a clavicle's, over the
+    // upper chest) between the armpits, where it is chest, not arm.
+    Cut chest;
+    {
+        std::vector<char> chest_bones = trunk;
+        for (const LimbChain* a : {&out.left_arm, &out.right_arm}) chest_bones[static_cast<std::size_t>(a->root)] = 1;
+        const bool sides = armpits_on_skin == 2 && armpit_side[0] > armpit_side[1];
+        constexpr int samples = 24;
+        for (int i = 0; i <= samples; ++i) {
+            const Real y = waist.center.y() + (out.underarm_m - waist.center.y()) * Real(i) / samples;
+            const Cut c = sides ? section(rig, indices, chest_bones, y, out.left, out.forward, armpit_side[1], armpit_side[0])
+                                : section(rig, indices, trunk, y, out.left, out.forward);
+            if (c.valid && (!chest.valid || c.girth > chest.girth)) chest = c;
+        }
+    }
     out.waist = make_section(waist);
     out.hips = make_section(hips.valid ? hips : waist);
     out.chest = make_section(chest.valid ? chest : waist);
     const Vec3 under(waist.center.x(), out.underarm_m, waist.center.z());
     out.under_arms = body_point(rig, spine_bone_at(rig, out.spine, out.underarm_m), under);
+
+    const std::string pelvis_name = "'" + skeleton.bone_names[static_cast<std::size_t>(pelvis)] + "'";
+    const std::string chest_name = "'" + skeleton.bone_names[static_cast<std::size_t>(out.chest_bone)] + "'";
+    out.how_found = {
+        {"pelvis", pelvis_name + (out.found_by == "bone names" ? ": its name, and two legs and a spine hang from it"
+                                                               : ": topology, the highest bone with two legs and a spine hanging from it")},
+        {"crotch", crotch_parted   ? "where the legs part: the lowest skin on the midplane between the thighs, above the knees"
+                   : crotch_on_skin ? "the lowest skin of the pelvis bone at the midplane (the legs do not part above the knees)"
+                                    : "5 % of the height under the pelvis joint (the legs do not part, no pelvis skin at the midplane)"},
+        {"hips", hips.valid ? "the widest section of trunk and thighs between crotch and waist" : "the waist's (no section below it)"},
+        {"waist", "the narrowest trunk section 30-80 % of the way from crotch to armpits"},
+        {"chest", !chest.valid ? "the waist's (no section above it)"
+                  : armpits_on_skin == 2 ? "the fullest section of the trunk (and the arms' first bones between the armpits) between waist and armpits"
+                                         : "the fullest trunk section between waist and armpits"},
+        {"under the arms", armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk, both sides"
+                           : armpits_on_skin == 1 ? "one side's lowest arm skin shared with the trunk; the other 6 % of the height under its shoulder joint"
+                                                  : "6 % of the height under the shoulder joints (arms and trunk are separate pieces)"},
+        {"shoulders", "the joints of the two chains reaching farthest sideways from spine bone " + chest_name},
+    };
     return out;
 }
 

@@ -16,8 +16,10 @@
 //  - section at a height: the skin triangles of the given bones cut by the horizontal
 //    plane there; the convex outline of the cut gives the centre, half width, half depth
 //    and girth.
-//  - crotch: the lowest skin point of the pelvis bone within 2 % of the height of the
-//    midplane.
+//  - crotch: where the legs part: the lowest point at which the midplane between the two
+//    thighs' joints cuts the skin, within 15 % of the height in front of or behind them and
+//    above the knees; else the lowest skin point of the pelvis bone within 2 % of the height
+//    of the midplane.
 //  - armpit: the lowest skin point of an arm chain on a triangle it shares with the trunk;
 //    where the two are separate pieces (a robot), the shoulder joint less 6 % of the
 //    height. underarm = the mean of the two.

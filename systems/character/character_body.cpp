@@ -11,9 +11,11 @@ Result<CharacterBody> fit_character_body(const CharacterAsset& character, const 
     if (!character.skeleton || !character.mesh) return fail(at + "no skeleton or mesh to fit a body to");
     CharacterBody body;
     body.hip_bone = find_hip_bone(*character.skeleton);
-    body.ellipsoids = fit_ellipsoids(*character.skeleton, *character.mesh, character.height_m, options, character.clips, character.meshes,
-                                     &body.legs);
-    if (auto landmarks = find_body_landmarks(character)) body.landmarks = std::move(*landmarks);
+    // A first look at the whole character finds its topology; the body is what is fitted.
+    if (auto first = find_body_landmarks(character)) body.left_out = find_non_body_meshes(character, *first);
+    const CharacterAsset fitted = body_only(character, body.left_out);
+    body.ellipsoids = fit_ellipsoids(*fitted.skeleton, *fitted.mesh, fitted.height_m, options, fitted.clips, fitted.meshes, &body.legs);
+    if (auto landmarks = find_body_landmarks(fitted)) body.landmarks = std::move(*landmarks);
     else body.landmarks_error = landmarks.error().message;
     return body;
 }

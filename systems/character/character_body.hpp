@@ -13,6 +13,7 @@
 #include "drape/components/ellipsoid_collider.hpp"
 #include "drape/engine/assets/character_asset.hpp"
 #include "drape/engine/core/error.hpp"
+#include "drape/systems/character/body_meshes.hpp"
 #include "drape/systems/character/ellipsoid_fit.hpp"
 
 namespace drape {
@@ -24,11 +25,14 @@ struct CharacterBody {
     LegFit legs = LegFit::bounding;          ///< The leg fit fit_ellipsoids used (tight or bounding).
     std::optional<BodyLandmarks> landmarks;  ///< find_body_landmarks(); none for a body that is not a humanoid.
     std::string landmarks_error;             ///< Why there are none.
+    std::vector<LeftOutMesh> left_out;       ///< Meshes not fitted: props, bases, modelled garments (body_meshes.hpp).
 };
 
-/// Fits the body of an imported character: find_hip_bone() on its skeleton,
-/// fit_ellipsoids() on its bind mesh, rest height and clips, and find_body_landmarks(). The error (bad options, no
-/// skeleton or mesh) names the character's file and the field.
+/// Fits the body of an imported character: find_hip_bone() on its skeleton; a first
+/// find_body_landmarks() on the whole character to tell its body from the rest
+/// (find_non_body_meshes()); then fit_ellipsoids() and find_body_landmarks() on the body's
+/// meshes only (its bind mesh, rest height and clips). The error (bad options, no skeleton
+/// or mesh) names the character's file and the field.
 [[nodiscard]] Result<CharacterBody> fit_character_body(const CharacterAsset& character, const FitOptions& options = {});
 
 }  // namespace drape

@@ -35,6 +35,7 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
     const MeshAsset& m = *c.mesh;
     std::string out = c.source.string() + "\n";
     out += format("  height      %.3f m (scale %.6g from %s)\n", double(c.height_m), c.scale, scale_source_name(c.scale_source));
+    if (!c.units_note.empty()) out += "  units       " + c.units_note + "\n";
     out += format("  meshes      %zu, %zu vertices, %zu triangles\n", c.meshes.size(), m.vertex_count(), m.indices.size() / 3);
     for (std::size_t i = 0; i < c.meshes.size(); ++i)
         out += format("    %-28s %6u vertices %6zu triangles%s\n", c.meshes[i].name.c_str(), c.meshes[i].vertex_count,
@@ -53,8 +54,26 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
                       double(l->hips.girth_m), double(l->chest.center.rest_m.y()), double(l->chest.girth_m), double(l->underarm_m));
         out += format("  limbs       legs %s, %s; arms %s, %s (left, right)\n", bone(l->left_leg.root), bone(l->right_leg.root),
                       bone(l->left_arm.root), bone(l->right_arm.root));
+        auto height_of = [&](const std::string& name) -> double {
+            if (name == "crotch") return l->crotch_m;
+            if (name == "hips") return l->hips.center.rest_m.y();
+            if (name == "waist") return l->waist.center.rest_m.y();
+            if (name == "chest") return l->chest.center.rest_m.y();
+            if (name == "under the arms") return l->underarm_m;
+            if (name == "shoulders") return 0.5 * double(l->left_shoulder.rest_m.y() + l->right_shoulder.rest_m.y());
+            return 0.0;
+        };
+        for (const auto& [name, how] : l->how_found) {
+            if (name == "pelvis") out += format("    %-15s         %s\n", name.c_str(), how.c_str());
+            else out += format("    %-15s %6.3f m %s\n", name.c_str(), height_of(name), how.c_str());
+        }
     } else {
         out += "  body        no landmarks: " + body.landmarks_error + "\n";
+    }
+    if (!body.left_out.empty()) {
+        out += format("  left out    %zu meshes of %zu from the body's fit and landmarks\n", body.left_out.size(), c.meshes.size());
+        for (const LeftOutMesh& x : body.left_out)
+            out += format("    %-28s %s\n", x.mesh < c.meshes.size() ? c.meshes[x.mesh].name.c_str() : "?", x.why.c_str());
     }
     out += format("  clips       %zu\n", c.clips.size());
     for (std::size_t i = 0; i < c.clips.size(); ++i) {
@@ -86,6 +105,7 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
     j["height_m"] = c.height_m;
     j["scale"] = c.scale;
     j["scale_source"] = scale_source_name(c.scale_source);
+    j["units"] = c.units_note;
     j["vertices"] = m.vertex_count();
     j["triangles"] = m.indices.size() / 3;
     j["meshes"] = json::array();
@@ -107,10 +127,16 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
                           {"waist", section(l->waist)}, {"hips", section(l->hips)}, {"chest", section(l->chest)},
                           {"legs", {bone(l->left_leg.root), bone(l->right_leg.root)}},
                           {"arms", {bone(l->left_arm.root), bone(l->right_arm.root)}}};
+        j["landmarks"]["how_found"] = json::object();
+        for (const auto& [name, how] : l->how_found) j["landmarks"]["how_found"][name] = how;
     } else {
         j["landmarks"] = nullptr;
         j["landmarks_error"] = body.landmarks_error;
     }
+    j["left_out"] = json::array();
+    for (const LeftOutMesh& x : body.left_out)
+        j["left_out"].push_back({{"mesh", x.mesh < c.meshes.size() ? c.meshes[x.mesh].name : std::string()},
+                                 {"garment", x.garment}, {"why", x.why}});
     j["clips"] = json::array();
     for (const auto& clip : c.clips)
         j["clips"].push_back({{"name", clip->name}, {"duration_s", clip->duration_s}, {"channels", clip->channels.size()},

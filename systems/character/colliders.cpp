@@ -43,6 +43,7 @@ void update_collider(EllipsoidCollider& c, const Skeleton& skeleton, const Trans
     c.acceleration_m_s2 = acceleration;
     c.angular_velocity_rad_s = angular;
     c.initialised = true;
+    c.placed = true;
     if (c.updates < 2) ++c.updates;
 }
 

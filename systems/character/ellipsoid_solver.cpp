@@ -343,8 +343,10 @@ struct Solver {
                 residuals(k, apply(current, x), near, cover, scale, r_step);
                 J.col(p) = (r_step - r) / step;
             });
-            const Mat9 H = J.transpose() * J;
-            const Vec9 g = J.transpose() * r;
+            // Coefficient by coefficient (lazyProduct): Eigen's blocked product splits the
+            // long sums where the CPU's cache sizes say, and rounds otherwise on another CPU.
+            const Mat9 H = J.transpose().lazyProduct(J);
+            const Vec9 g = J.transpose().lazyProduct(r);
             bool improved = false;
             while (lambda < 1e10) {
                 Mat9 A = H;

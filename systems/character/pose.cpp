@@ -65,17 +65,34 @@ void rest_pose(const SkeletonAsset& skeleton, std::vector<Affine3>& local) {
 }
 
 void sample_clip(const AnimationClip& clip, const SkeletonAsset& skeleton, double time_s, bool in_place,
-                 std::vector<Affine3>& local) {
+                 std::vector<Affine3>& local, bool loop) {
     rest_pose(skeleton, local);
     if (!std::isfinite(time_s)) time_s = 0;  // never let a bad clock reach the pose
     const int bones = static_cast<int>(skeleton.size());
+    // The seam's share at this time: 0 before the blend, 1 at the clip's end (smoothstep).
+    Real seam = 0;
+    if (loop && clip.seam_blend_s > 0 && time_s > clip.duration_s - clip.seam_blend_s) {
+        const Real u = static_cast<Real>(std::min(1.0, (time_s - (clip.duration_s - clip.seam_blend_s)) / clip.seam_blend_s));
+        seam = u * u * (3 - 2 * u);
+    }
     for (const BoneChannel& c : clip.channels) {
         if (c.bone < 0 || c.bone >= bones) continue;
         const auto b = static_cast<std::size_t>(c.bone);
         Vec3 t = c.positions.empty() ? skeleton.rest_translation[b]
                                      : lerp_keys(c.position_times_s, c.positions, time_s);
-        const Quat r = c.rotations.empty() ? skeleton.rest_rotation[b]
-                                           : slerp_keys(c.rotation_times_s, c.rotations, time_s);
+        Quat r = c.rotations.empty() ? skeleton.rest_rotation[b]
+                                     : slerp_keys(c.rotation_times_s, c.rotations, time_s);
+        if (seam > 0) {
+            if (c.rotations.size() >= 2) {
+                const Quat gap = (c.rotations.front() * c.rotations.back().conjugate()).normalized();
+                r = (Quat::Identity().slerp(seam, gap) * r).normalized();
+            }
+            if (c.positions.size() >= 2) {
+                Vec3 gap = c.positions.front() - c.positions.back();
+                if (c.bone == clip.motion_bone) gap += clip.travel_local;  // the cycle's travel stays
+                t += seam * gap;
+            }
+        }
         const Vec3 s = c.scales.empty() ? skeleton.rest_scale[b] : lerp_keys(c.scale_times_s, c.scales, time_s);
         if (in_place && c.bone == clip.motion_bone && clip.duration_s > 0)
             t -= clip.travel_local * static_cast<Real>(time_s / clip.duration_s);

@@ -33,9 +33,13 @@ struct ClipTime {
 
 /// Local pose at `time_s` (seconds within the clip). Bones the clip does not animate keep
 /// their rest pose; channels for out-of-range bones are ignored. `in_place` removes the
-/// clip's horizontal travel from its motion bone. `local` is resized to the skeleton.
+/// clip's horizontal travel from its motion bone. `loop`: the clip is played as a loop, and a
+/// near-loop's seam is blended (AnimationClip::seam_blend_s): over its last stretch each
+/// channel turns (and moves) by a growing share of the gap from its last key to its first,
+/// eased in and out, so the pose at the end is the pose at the start. `local` is resized
+/// to the skeleton.
 void sample_clip(const AnimationClip& clip, const SkeletonAsset& skeleton, double time_s, bool in_place,
-                 std::vector<Affine3>& local);
+                 std::vector<Affine3>& local, bool loop = false);
 
 /// The rest (node) pose.
 void rest_pose(const SkeletonAsset& skeleton, std::vector<Affine3>& local);

@@ -154,6 +154,7 @@ SkinSurface::Closest SkinSurface::closest(const Vector3d& p) const {
     const Vector3d face = (b - a).cross(c - a).normalized();
     if (normal.norm() < 1e-9) normal = face;  // opposed vertex normals: the face decides
     best.normal = normal.normalized();
+    best.weights = best_bary;
     best.distance_m = std::sqrt(best_d2);
     best.outside = (p - best.point).dot(best.normal) > 0;
     return best;

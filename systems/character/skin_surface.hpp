@@ -32,6 +32,7 @@ public:
         Eigen::Vector3d normal = Eigen::Vector3d::UnitY(); ///< Interpolated vertex normal there (unit).
         double distance_m = 0;                             ///< From the query point.
         std::int64_t triangle = -1;                        ///< Index of the face; -1: the surface is empty.
+        Eigen::Vector3d weights = Eigen::Vector3d::UnitX(); ///< `point`'s barycentric weights on triangle(triangle)'s vertices.
         bool outside = false;                              ///< The query point is on the normal's side.
     };
     [[nodiscard]] Closest closest(const Eigen::Vector3d& point) const;

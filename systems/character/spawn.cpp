@@ -77,7 +77,8 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
         collider.radii_m = s.radii_m;
         collider.region = s.region;
         collider.give_m = s.give_m;
-        // World transform valid at once; velocities start with the first step.
+        // World transform valid at once (placed, so a garment can be attached before the
+        // first step); velocities start with the first step.
         update_collider(collider, registry.get<Skeleton>(e), &registry.get<Transform>(e), 0);
         collider.initialised = false;
         collider.updates = 0;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "drape/components/ground_plane.hpp"
 #include "drape/systems/cloth/body.hpp"
 
 namespace drape {
@@ -937,6 +938,26 @@ CollisionResult collide_range(Garment& g, GarmentSolver& solver, Eigen::Index fi
     const CollisionResult r = collide_part(g, solver, g.state.x, g.state.v, first, end, respond_velocity, counters, detected);
     add_part_counters(g, counters);
     return r;
+}
+
+Real ground_height(const Registry& registry) {
+    Real height = -std::numeric_limits<Real>::infinity();
+    registry.each<GroundPlane>([&](Entity, const GroundPlane& ground) { height = std::max(height, ground.height_m); });
+    return height;
+}
+
+std::uint64_t collide_ground(Matrix3X& x, const VectorX& inv_mass, Real ground_m, Eigen::Index first, Eigen::Index end,
+                             Matrix3X* push) {
+    std::uint64_t moved = 0;
+    if (!(ground_m > -std::numeric_limits<Real>::infinity())) return moved;
+    for (Eigen::Index p = first; p < end; ++p) {
+        const Real below = ground_m - x(1, p);
+        if (!(below > 0) || inv_mass[p] == 0) continue;
+        x(1, p) = ground_m;
+        if (push) (*push)(1, p) += below;
+        ++moved;
+    }
+    return moved;
 }
 
 CollisionResult collide_garment(Garment& g, GarmentSolver& solver, DetectedPairs* detected) {

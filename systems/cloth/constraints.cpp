@@ -18,6 +18,25 @@ std::vector<Real> spring_compliance(const SpringPhase& springs, const VectorX& a
     return c;
 }
 
+std::uint64_t provot_pass(const SpringPhase& sp, const VectorX& w, Real limit, Matrix3X& x) {
+    std::uint64_t corrected = 0;
+    const Real scale = 1 + limit;
+    for (std::size_t s = 0; s < sp.size(); ++s) {
+        const std::uint32_t a = sp.a[s], b = sp.b[s];
+        const bool free_a = w[a] != 0, free_b = w[b] != 0;
+        if (!free_a && !free_b) continue;
+        const Vec3 d = x.col(b) - x.col(a);
+        const Real len = d.norm(), bound = scale * sp.rest_m[s];
+        if (!(len > bound)) continue;
+        const Vec3 back = ((len - bound) / len) * d;  // what brings b back toward a to the bound
+        const Real share_a = free_a && free_b ? Real(0.5) : (free_a ? Real(1) : Real(0));
+        x.col(a) += share_a * back;
+        x.col(b) -= (1 - share_a) * back;
+        ++corrected;
+    }
+    return corrected;
+}
+
 std::vector<SpringStrip> spring_strips(const SpringPhase& sp) {
     std::vector<SpringStrip> strips;
     const std::uint32_t n = static_cast<std::uint32_t>(sp.size());

@@ -108,6 +108,12 @@ void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 std::uint64_t limit_warp_lines(const Fabric& fabric, const VectorX& rest_above, const VectorX& inv_mass, Real stretch,
                       Matrix3X& x, Matrix3X& moves, std::uint32_t first_line, std::uint32_t end_line);
 
+/// Provot's limit as Provot gives it (method §4.1), for the paper's integrator: one
+/// Gauss-Seidel pass over `springs` in their order; a spring longer than (1 + limit) x rest
+/// has its ends moved toward each other back to that length, half each when both are free,
+/// only the free one when the other is pinned (`inv_mass` 0). Returns the springs corrected.
+std::uint64_t provot_pass(const SpringPhase& springs, const VectorX& inv_mass, Real limit, Matrix3X& x);
+
 /// Per particle: rest length of the weft spring to its neighbour on the next line (0 for
 /// none).
 [[nodiscard]] VectorX weft_rest_right(const Fabric& fabric);

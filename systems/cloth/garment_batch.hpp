@@ -6,10 +6,8 @@
 
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "drape/components/garment.hpp"
+#include "drape/engine/core/jobs.hpp"
 #include "drape/engine/core/registry.hpp"
 #include "drape/systems/cloth/garment_solver.hpp"
 
@@ -40,16 +38,14 @@ struct GarmentBatch {
         });
     }
 
-    /// Runs f(garment, solver) for every item, in parallel when there is more than one.
+    /// Runs f(garment, solver) for every item, on the job system when there is more than one.
     template <class F>
     void for_each(F&& f) const {
         if (items.size() == 1) {
             f(*items.front().garment, *items.front().solver);
             return;
         }
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size()), [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t i = range.begin(); i != range.end(); ++i) f(*items[i].garment, *items[i].solver);
-        });
+        job_system().parallel_for(items.size(), [&](std::size_t i) { f(*items[i].garment, *items[i].solver); });
     }
 };
 

@@ -80,7 +80,7 @@ Matrix3X to_particle_order(const Fabric& t, const Matrix3X& grid_positions) {
 }
 
 Garment make_instance(std::shared_ptr<const Fabric> fabric, Matrix3X x, const ClothMaterial& material,
-                      ClothModel model, CollisionMode collision, const Vec3& color) {
+                      ClothModel model, ClothIntegrator integrator, CollisionMode collision, const Vec3& color) {
     Garment g;
     const Eigen::Index n = x.cols();
     g.fabric = std::move(fabric);
@@ -89,6 +89,7 @@ Garment make_instance(std::shared_ptr<const Fabric> fabric, Matrix3X x, const Cl
     g.state.inv_mass = (material.areal_density_kg_m2 * g.fabric->area_m2).cwiseInverse();
     g.config.material = material;
     g.config.model = model;
+    g.config.integrator = integrator;
     g.config.collision = collision;
     g.config.color = color;
     return g;
@@ -236,19 +237,18 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
     return pin;
 }
 
-// Pins `rows` rows, pushes the rest out of the colliders, records the rest shape, and
-// adds the garment to the registry.
-Result<Entity> finish(Registry& registry, Garment g, int rows) {
+// Pins the particles `pinned` marks (grid order, line * m + row), pushes the rest out of
+// the colliders, records the rest shape, and adds the garment to the registry.
+Result<Entity> finish(Registry& registry, Garment g, const std::vector<std::uint8_t>& pinned) {
     const Fabric& t = *g.fabric;
     GarmentSolver solver;
     GarmentState& state = g.state;
     update_frames(registry, g.body, solver.frames, 1);
-    for (std::uint32_t line = 0; line < t.warp_lines; ++line) {
-        for (std::uint32_t row = 0; row < static_cast<std::uint32_t>(rows); ++row) {
-            const std::uint32_t p = t.grid[line * t.particles_per_line + row];
-            state.inv_mass[p] = 0;
-            state.pins.push_back(bind_pin(registry, g.body.character, g.body.colliders, solver.frames, p, state.x.col(p)));
-        }
+    for (std::size_t k = 0; k < t.grid.size(); ++k) {
+        if (!pinned.at(k)) continue;
+        const std::uint32_t p = t.grid[k];
+        state.inv_mass[p] = 0;
+        state.pins.push_back(bind_pin(registry, g.body.character, g.body.colliders, solver.frames, p, state.x.col(p)));
     }
     for (const PinBinding& pin : state.pins)
         if (auto at = evaluate_pin(registry, g, pin)) state.x.col(pin.particle) = *at;
@@ -280,7 +280,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     std::vector<int> leg_bone;       // per collider: its bone on a leg, else -1
     for (Entity e : colliders) {
         const auto& c = registry.get<EllipsoidCollider>(e);
-        placed = placed || c.initialised;
+        placed = placed || c.placed || c.initialised;
         frames.push_back(make_ellipsoid_frame(c.world));
         limb.push_back(hangs_outside_garments(c.region));
         leg_bone.push_back(is_leg(c.region) ? c.bone : -1);
@@ -433,7 +433,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     }
     auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());
-    Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.collision, s.color);
+    Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.integrator, s.collision, s.color);
     g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular};
     g.body.character = character;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
@@ -449,7 +449,10 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
         if (e == anchor) g.body.anchor = static_cast<std::int32_t>(g.body.colliders.size());
         g.body.colliders.push_back(colliders[e]);
     }
-    return finish(registry, std::move(g), s.fitting_rows);
+    std::vector<std::uint8_t> pinned(g.fabric->grid.size(), 0);
+    for (int line = 0; line < n; ++line)
+        for (int row = 0; row < s.fitting_rows; ++row) pinned[static_cast<std::size_t>(line * m + row)] = 1;
+    return finish(registry, std::move(g), pinned);
 }
 
 }  // namespace
@@ -568,6 +571,8 @@ Result<std::shared_ptr<const Fabric>> build_grid_topology(int lines_in, int per_
         *phase = std::move(sorted);
     }
 
+    t->rest_shape = pos;
+
     // Rest area per particle: a quarter of each grid quad around it (two triangles).
     t->area_m2 = VectorX::Zero(n * m);
     for (std::uint32_t line = 0; line < weft_lines; ++line)
@@ -628,6 +633,68 @@ Result<Entity> attach_dress(Registry& registry, Entity character, const TubePara
     return attach_tube(registry, character, "dress", params);
 }
 
+Result<Entity> attach_grid_garment(Registry& registry, Entity character, const GridGarment& grid, std::string_view name) {
+    const std::string p(name);
+    if (!registry.valid(character)) return fail(p + ": the character entity is not alive");
+    const auto cells = static_cast<std::size_t>(grid.warp_lines) * static_cast<std::size_t>(std::max(grid.particles_per_line, 0));
+    if (grid.grid_positions.cols() != static_cast<Eigen::Index>(cells) || grid.pinned.size() != cells)
+        return fail(p + ": the grid's positions and pins do not match its " + std::to_string(grid.warp_lines) + " x " +
+                    std::to_string(grid.particles_per_line) + " particles");
+    if (std::none_of(grid.pinned.begin(), grid.pinned.end(), [](std::uint8_t k) { return k != 0; }))
+        return fail(p + ": no particle is held to the body");
+    if (auto ok = validate(grid.config.material, p + ".material"); !ok) return std::unexpected(ok.error());
+    const std::vector<Entity> colliders = character_colliders(registry, character);
+    if (colliders.empty()) return fail(p + ": the character has no ellipsoid colliders");
+    if (colliders.size() > 64) return fail(p + ": the character has " + std::to_string(colliders.size()) +
+                                           " colliders; a garment handles at most 64");
+    const auto* transform = registry.try_get<Transform>(character);
+    const Affine3 to_world = transform ? transform->matrix() : Affine3::Identity();
+    const Matrix3X world = to_world * grid.grid_positions;
+    auto topology = build_grid_topology(grid.warp_lines, grid.particles_per_line, grid.weft_stride, grid.closed, world, name);
+    if (!topology) return std::unexpected(topology.error());
+    const GarmentConfig& c = grid.config;
+    Garment g = make_instance(*topology, to_particle_order(**topology, world), c.material, c.model, c.integrator, c.collision, c.color);
+    g.config.inertia = c.inertia;
+    g.body.character = character;
+
+    // Where it is held: the pins' centre. Held between the midpoint of the waist and the
+    // armpits and the midpoint of the armpits and the shoulders (a strapless dress, a top),
+    // the upper arms hang outside it, against its sides, as they do beside the built-in
+    // dress; held higher (a cape on the shoulders), it lies over them.
+    Vec3 held = Vec3::Zero();
+    int held_count = 0;
+    for (std::size_t k = 0; k < cells; ++k)
+        if (grid.pinned[k]) held += world.col(static_cast<Eigen::Index>(k)), ++held_count;
+    held /= Real(held_count);
+    bool arms_outside = false;
+    const auto* landmarks = registry.try_get<BodyLandmarks>(character);
+    const auto* pose = registry.try_get<Skeleton>(character);
+    if (landmarks && pose && transform && !pose->global.empty()) {
+        const Real waist = landmark_world(landmarks->waist.center, *pose, *transform).y();
+        const Real arms = landmark_world(landmarks->under_arms, *pose, *transform).y();
+        const Real shoulders = Real(0.5) * (landmark_world(landmarks->left_shoulder, *pose, *transform).y() +
+                                            landmark_world(landmarks->right_shoulder, *pose, *transform).y());
+        arms_outside = held.y() > Real(0.5) * (waist + arms) && held.y() < Real(0.5) * (arms + shoulders);
+    }
+    // Anchor: the torso's collider nearest the pins (the pelvis for a skirt, the chest for a
+    // dress), else the nearest of any.
+    Real nearest = std::numeric_limits<Real>::infinity();
+    bool nearest_is_trunk = false;
+    for (Entity e : colliders) {
+        const auto& collider = registry.get<EllipsoidCollider>(e);
+        if (arms_outside && collider.region == BodyRegion::upper_arm) continue;
+        const bool trunk = collider.region == BodyRegion::pelvis || collider.region == BodyRegion::torso;
+        const Real d = (make_ellipsoid_frame(collider.world).center - held).norm();
+        if ((trunk && !nearest_is_trunk) || (trunk == nearest_is_trunk && d < nearest)) {
+            nearest = d;
+            nearest_is_trunk = trunk;
+            g.body.anchor = static_cast<std::int32_t>(g.body.colliders.size());
+        }
+        g.body.colliders.push_back(e);
+    }
+    return finish(registry, std::move(g), grid.pinned);
+}
+
 Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity> colliders) {
     if (auto ok = validate(r); !ok) return std::unexpected(ok.error());
     if (colliders.size() > 64) return fail("rectangle: at most 64 colliders, got " + std::to_string(colliders.size()));
@@ -641,7 +708,7 @@ Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity>
         }
     auto topology = build_grid_topology(n, m, r.weft_stride, false, grid, "rectangle");
     if (!topology) return std::unexpected(topology.error());
-    Garment g = make_instance(*topology, to_particle_order(**topology, grid), r.material, r.model, r.collision, r.color);
+    Garment g = make_instance(*topology, to_particle_order(**topology, grid), r.material, r.model, r.integrator, r.collision, r.color);
     g.body.colliders.assign(colliders.begin(), colliders.end());
     if (r.pin_top_row)
         for (int line = 0; line < n; ++line) {

@@ -3,7 +3,8 @@
 //
 // Placement (skirt and dress): the character's colliders are the EllipsoidCollider
 // entities whose `character` is that entity, in entity order, and must have been placed
-// (the collider system has run, or a test set `world` and `initialised`). On a character
+// (spawn_character places them, the collider system keeps them placed, or a test set
+// `world` and `initialised`). On a character
 // with BodyLandmarks (systems/character/body_landmarks.hpp) the ring sits at its waist
 // (skirt) or 2 % of its height under the armpits (dress), on the vertical axis through
 // that landmark as the character stands now; elsewhere the body's height is the vertical
@@ -24,6 +25,7 @@
 #include <memory>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "drape/components/garment.hpp"
 #include "drape/engine/core/error.hpp"
@@ -64,6 +66,7 @@ struct TubeParams {
     Real inertia_angular = 1;         ///< InertiaScales::angular.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
+    ClothIntegrator integrator = ClothIntegrator::shipped;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.75f, 0.12f, 0.18f);
 
@@ -97,6 +100,7 @@ struct RectangleParams {
     bool pin_top_row = true;          ///< Pin row 0 in world space.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
+    ClothIntegrator integrator = ClothIntegrator::shipped;
     CollisionMode collision = CollisionMode::candidate_lists;
     Vec3 color = Vec3(0.8f, 0.8f, 0.8f);
 };
@@ -124,6 +128,27 @@ inline constexpr int max_garment_particles = 250'000;
 
 /// Dress on `character`: a tube whose errors are named "dress.<field>". Returns the garment entity.
 [[nodiscard]] Result<Entity> attach_dress(Registry& registry, Entity character, const TubeParams& params = TubeParams::dress());
+
+/// A garment from any particle grid (garments from files: systems/cloth/garment_from_mesh.hpp),
+/// laid out as the built-in ones are (components/garment.hpp): `warp_lines` lines of
+/// `particles_per_line`, row 0 at the held edge.
+struct GridGarment {
+    int warp_lines = 0;
+    int particles_per_line = 0;
+    int weft_stride = 3;               ///< Closed: warp_lines a multiple of it; open: warp_lines - 1.
+    bool closed = false;               ///< The last line's weft joins the first (a tube).
+    Matrix3X grid_positions;           ///< Character model space, grid order (line * m + row).
+    std::vector<std::uint8_t> pinned;  ///< Grid order: 1 = held to the skin (method §3.5).
+    GarmentConfig config;              ///< Model, integrator, collision, material, inertia, colour.
+};
+
+/// `grid` on `character`, placed by the character's Transform; pins bound to the skin as the
+/// built-in garments' are; it collides with every collider of the character, except the
+/// upper arms when it is held between the midpoint of the waist and the armpits and that of
+/// the armpits and the shoulders (they hang outside a strapless dress; a cape held on the
+/// shoulders lies over them). Errors are named `name` ("garments[0]").
+[[nodiscard]] Result<Entity> attach_grid_garment(Registry& registry, Entity character, const GridGarment& grid,
+                                                 std::string_view name);
 
 /// A flat rectangle, pinned in world space, colliding with `colliders` (no body).
 [[nodiscard]] Result<Garment> make_rectangle(const RectangleParams& params, std::span<const Entity> colliders = {});

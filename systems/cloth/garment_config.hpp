@@ -14,7 +14,7 @@ namespace drape {
 bool set_garment_model(Registry& registry, Entity garment, ClothModel model);
 
 /// Replaces the garment's material after checking it (the error names the field, e.g.
-/// "material.stretch_k_N_m"); on an error nothing changes.
+/// "material.stretch_N_m"); on an error nothing changes.
 [[nodiscard]] Result<void> set_garment_material(Registry& registry, Entity garment, const ClothMaterial& material);
 
 /// Puts the particles at `x` with velocities `v` (a saved state, a checkpoint); pins keep

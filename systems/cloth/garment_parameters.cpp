@@ -148,6 +148,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
         real("friction", &ClothMaterial::friction, closed(0, 10), "", "Coulomb friction coefficient of the cloth on the body"),
         real("strain_limit", &ClothMaterial::strain_limit, open_min(0, 10), "",
              "Provot's largest relative over-stretch (method §4.1); 0.1 = 10 %"),
+        real("compression_limit", &ClothMaterial::compression_limit, closed(0, 1), "",
+             "the shortest a spring may become over its rest length, the cloth's folds being coarser than its grid; 0 = none"),
         integer("iterations", &ClothMaterial::iterations, closed(1, 100),
                 "constraint and collision rounds per substep (Gauss-Seidel)"),
         real("candidate_margin_m", &ClothMaterial::candidate_margin_m, open_min(0, 1), "m",

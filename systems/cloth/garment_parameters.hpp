@@ -62,7 +62,7 @@ struct GarmentParameterSpec : ParameterSpec {
 
     /// True for the fields of TubeParams::material.
     [[nodiscard]] bool in_material() const noexcept;
-    /// The field as the builder's messages name it: "length_m", "material.mass_kg".
+    /// The field as the builder's messages name it: "length_m", "material.areal_density_kg_m2".
     [[nodiscard]] std::string field() const;
     /// The field's value in `params`.
     [[nodiscard]] double get(const TubeParams& params) const;

@@ -20,12 +20,8 @@
 #include <utility>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
-#include <tbb/global_control.h>
-
 #include "drape/components/garment.hpp"
+#include "drape/engine/core/jobs.hpp"
 #include "drape/engine/core/math.hpp"
 
 namespace drape {
@@ -65,20 +61,17 @@ struct GarmentParts {
 [[nodiscard]] GarmentParts make_parts(const Fabric& fabric, ClothModel model, Eigen::Index integrated);
 
 /// Calls f(k) for every part k in [0, count): in order on the calling thread for one part
-/// or when TBB may use one thread (tbb::global_control), else as TBB tasks (one part each)
-/// on the threads TBB has, returning when all are done.
+/// or when the job system runs one thread at a time, else on the job system
+/// (engine/core/jobs.hpp: TBB's unless the game installed its own), returning when all are
+/// done.
 template <class F>
 void for_each_part(std::size_t count, F&& f) {
-    if (count == 1 || tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) == 1) {
+    JobSystem& jobs = job_system();
+    if (count == 1 || jobs.max_concurrency() == 1) {
         for (std::size_t k = 0; k < count; ++k) f(k);
         return;
     }
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, count, 1),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t k = r.begin(); k != r.end(); ++k) f(k);
-        },
-        tbb::static_partitioner());
+    jobs.parallel_for(count, [&](std::size_t k) { f(k); });
 }
 
 }  // namespace drape

@@ -28,7 +28,32 @@ Real StrainHistogram::percentile(double q) const noexcept {
     return Real(bins) * bin;
 }
 
-GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame> frames, StrainHistogram* histogram) {
+Vec3 body_up(const Garment& g, std::span<const EllipsoidFrame> frames) {
+    const GarmentBody& b = g.body;
+    const VectorX& w = g.state.inv_mass;
+    if (b.anchor < 0 || static_cast<std::size_t>(b.anchor) >= frames.size() || !frames[static_cast<std::size_t>(b.anchor)].active ||
+        b.rest_local.cols() != w.size())
+        return Vec3::UnitY();
+    Vec3 pins = Vec3::Zero(), free = Vec3::Zero();
+    Real n_pins = 0, n_free = 0;
+    for (Eigen::Index i = 0; i < w.size(); ++i) {
+        if (w[i] == 0) {
+            pins += b.rest_local.col(i);
+            n_pins += 1;
+        } else {
+            free += b.rest_local.col(i);
+            n_free += 1;
+        }
+    }
+    if (n_pins == 0 || n_free == 0) return Vec3::UnitY();
+    const Vec3 local = pins / n_pins - free / n_free;
+    if (!(local.norm() > Real(1e-6))) return Vec3::UnitY();
+    const Vec3 up = anchor_frame(frames, b.anchor).linear() * local.normalized();
+    return up.allFinite() ? up : Vec3::UnitY();
+}
+
+GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame> frames, StrainHistogram* histogram,
+                               Real ground_m) {
     GarmentQuality q;
     if (!g.fabric) return q;
     const Fabric& t = *g.fabric;
@@ -43,6 +68,7 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
             const std::uint32_t a = phase->a[s], b = phase->b[s];
             if (w[a] == 0 && w[b] == 0) continue;
             const Real ratio = (x.col(b) - x.col(a)).norm() / phase->rest_m[s];
+            if (std::isfinite(ratio)) q.compression_min = std::min(q.compression_min, ratio);
             const Real strain = std::isfinite(ratio) ? std::max(Real(0), ratio - 1) : std::numeric_limits<Real>::infinity();
             strains.push_back(strain);
             if (histogram) histogram->add(strain);
@@ -55,12 +81,16 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
         q.strain_max = *std::max_element(strains.begin(), strains.end());
     }
 
+    const Vec3 up = body_up(g, frames);
     Real highest_pin = -std::numeric_limits<Real>::infinity();
     for (Eigen::Index i = 0; i < x.cols(); ++i)
-        if (w[i] == 0) highest_pin = std::max(highest_pin, x(1, i));
+        if (w[i] == 0) highest_pin = std::max(highest_pin, up.dot(x.col(i)));
     for (Eigen::Index i = 0; i < x.cols(); ++i)
-        if (w[i] != 0 && std::isfinite(highest_pin) && std::isfinite(x(1, i)))
-            q.rise_above_pins_m = std::max(q.rise_above_pins_m, x(1, i) - highest_pin);
+        if (w[i] != 0 && std::isfinite(highest_pin) && x.col(i).allFinite())
+            q.rise_above_pins_m = std::max(q.rise_above_pins_m, up.dot(x.col(i)) - highest_pin);
+    if (ground_m > -std::numeric_limits<Real>::infinity())
+        for (Eigen::Index i = 0; i < x.cols(); ++i)
+            if (w[i] != 0 && std::isfinite(x(1, i))) q.below_ground_m = std::max(q.below_ground_m, ground_m - x(1, i));
     // Depths: each ellipsoid against the particles in its bounding box only; past its give
     // where it gives (collision.hpp), the depth within the give kept apart.
     for (std::size_t e = 0; e < frames.size(); ++e) {
@@ -85,7 +115,14 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
 GarmentQuality measure_garment(const Registry& registry, const Garment& garment, StrainHistogram* histogram) {
     std::vector<EllipsoidFrame> frames;
     update_frames(registry, garment.body, frames, 1);
-    return measure_garment(garment, frames, histogram);
+    return measure_garment(garment, frames, histogram, ground_height(registry));
+}
+
+double kinetic_energy_J(const Matrix3X& v, const VectorX& inv_mass) {
+    double e = 0;
+    for (Eigen::Index i = 0; i < v.cols() && i < inv_mass.size(); ++i)
+        if (inv_mass[i] > 0) e += 0.5 / inv_mass[i] * static_cast<double>(v.col(i).squaredNorm());
+    return e;
 }
 
 }  // namespace drape

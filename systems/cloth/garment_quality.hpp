@@ -5,17 +5,23 @@
 // Conventions
 // - Strain of a spring: length / rest - 1 (compression counts as 0), over every structural
 //   spring (warp of both layers, weft) with at least one free end: between two pinned
-//   particles the skin decides.
+//   particles the skin decides. Compression is reported apart: the shortest of those springs
+//   over its rest length.
 // - Depth inside an ellipsoid: how far the centre-line response would move the particle out
 //   (collision.hpp penetration_depth), an upper bound of its distance to the surface; for an
 //   ellipsoid that gives (EllipsoidCollider::give_m), the depth past what its give allows
 //   there (depth_past_give), the depth within the give reported apart.
+// - Below the floor: how far a free particle lies under the GroundPlane's height.
 // - Rise above the pins: the largest height of a free particle above the highest pinned
-//   particle, along world up (+Y); 0 when none is higher.
+//   particle, along the body's up (body_up): the direction from the garment's free
+//   particles to its pins in its rest shape, carried by the anchor's rotation, so that a
+//   body lying down (a fall, a death) or bent over (sitting) is measured as it stands; 0 when
+//   none is higher.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -25,13 +31,20 @@
 
 namespace drape {
 
+/// The body's up for the rise above the pins: from the mean of the garment's free particles
+/// to the mean of its pinned ones in its rest shape (GarmentBody::rest_local), turned by
+/// the anchor's rotation among `frames`. World up (+Y) without an anchor or pins.
+[[nodiscard]] Vec3 body_up(const Garment& garment, std::span<const EllipsoidFrame> frames);
+
 /// One garment after one frame.
 struct GarmentQuality {
     Real strain_max = 0;            ///< Largest strain of a spring with a free end.
     Real strain_p99 = 0;            ///< Its 99th percentile over those springs.
+    Real compression_min = 1;       ///< Shortest of those springs over its rest length (1: none shorter than rest).
     Real penetration_m = 0;         ///< Deepest free particle inside an ellipsoid (past its give).
     Real within_give_m = 0;         ///< Deepest free particle inside an ellipsoid within its give.
     Real pins_inside_m = 0;         ///< Deepest pinned particle inside an ellipsoid.
+    Real below_ground_m = 0;        ///< Deepest free particle below the floor (components/ground_plane.hpp).
     Real rise_above_pins_m = 0;     ///< See the conventions above.
     std::uint64_t nonfinite = 0;    ///< Non-finite coordinates in x and v.
     std::uint64_t springs = 0;      ///< Springs measured.
@@ -52,13 +65,17 @@ private:
     std::uint64_t m_samples = 0;
 };
 
-/// Measures `garment` against `frames` (the colliders as the cloth sees them, e.g. the
-/// solver's frames at the end of the step). When `histogram` is given, every measured
-/// spring's strain is added to it.
-[[nodiscard]] GarmentQuality measure_garment(const Garment& garment, std::span<const EllipsoidFrame> frames,
-                                             StrainHistogram* histogram = nullptr);
+/// Kinetic energy of particles with masses 1 / inv_mass (pinned ones, inv_mass 0, left out), J.
+[[nodiscard]] double kinetic_energy_J(const Matrix3X& v, const VectorX& inv_mass);
 
-/// The same with the colliders read from the registry at their current pose.
+/// Measures `garment` against `frames` (the colliders as the cloth sees them, e.g. the
+/// solver's frames at the end of the step) and the floor `ground_m` (-inf: none). When
+/// `histogram` is given, every measured spring's strain is added to it.
+[[nodiscard]] GarmentQuality measure_garment(const Garment& garment, std::span<const EllipsoidFrame> frames,
+                                             StrainHistogram* histogram = nullptr,
+                                             Real ground_m = -std::numeric_limits<Real>::infinity());
+
+/// The same with the colliders read from the registry at their current pose, and its floor.
 [[nodiscard]] GarmentQuality measure_garment(const Registry& registry, const Garment& garment,
                                              StrainHistogram* histogram = nullptr);
 

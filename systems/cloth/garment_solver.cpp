@@ -15,29 +15,15 @@ void invalidate(GarmentSolver& s) {
 
 namespace {
 
-// The solver's masses and drags: the state's (1 / inverse mass, material drag x area); in the
-// simplified model each layer-2 particle's shares go to the layer-1 ends of its chord.
+// The solver's masses and drags: the state's (1 / inverse mass, material drag x area), each
+// particle's own. In the simplified model a layer-2 particle is carried by its layer-1
+// neighbours in the prediction (weft.hpp) and keeps its own mass in the constraint rounds:
+// adding it to its neighbours as well would count it twice there (and the prediction, whose
+// drag over mass is the material's per area either way, does not need it).
 void derive_masses(const Garment& g, GarmentSolver& s) {
-    const Fabric& t = *g.fabric;
     const VectorX& w = g.state.inv_mass;
-    const Eigen::Index n = w.size();
-    VectorX mass = VectorX::Zero(n);
-    for (Eigen::Index i = 0; i < n; ++i) mass[i] = w[i] > 0 ? 1 / w[i] : Real(0);
-    VectorX drag = g.config.material.drag_N_s_m3 * t.area_m2;
-    if (g.config.model == ClothModel::simplified) {
-        for (std::size_t k = 0; k < t.weft_particle.size(); ++k) {
-            const std::uint32_t p = t.weft_particle[k], a = t.weft_left[k], b = t.weft_right[k];
-            const Real share = t.weft_t[k];
-            if (w[p] == 0) continue;  // pinned in the fitting zone: the skin carries it
-            mass[a] += (1 - share) * mass[p];
-            mass[b] += share * mass[p];
-            drag[a] += (1 - share) * drag[p];
-            drag[b] += share * drag[p];
-        }
-    }
-    s.inv_mass = VectorX::Zero(n);
-    for (Eigen::Index i = 0; i < n; ++i) s.inv_mass[i] = w[i] > 0 && mass[i] > 0 ? 1 / mass[i] : Real(0);
-    s.drag_N_s_m = drag;
+    s.inv_mass = w;
+    s.drag_N_s_m = g.config.material.drag_N_s_m3 * g.fabric->area_m2;
 }
 
 SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus, bool limited, const GarmentParts& parts) {
@@ -88,6 +74,21 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts));
             s.springs.push_back(spring_set(t.warp2, area, m.stretch_N_m, true, parts));
         }
+        // The paper's integrator: its masses, its explicit springs and their stability bound.
+        s.paper_inv_mass = s.inv_mass;
+        if (simplified)
+            for (Eigen::Index p = 0; p < n; ++p)
+                if (s.paper_inv_mass[p] != 0) s.paper_inv_mass[p] = 1 / (m.areal_density_kg_m2 * area[p]);
+        s.explicit_sets.clear();
+        s.provot_first.clear();
+        s.provot_then.clear();
+        for (std::size_t k = 0; k < s.springs.size(); ++k) {
+            const SpringPhase* phase = s.springs[k].springs;
+            if (!simplified || phase == &t.warp1) s.explicit_sets.push_back(k);
+            if (!s.springs[k].limited) continue;
+            (!simplified || phase == &t.warp1 ? s.provot_first : s.provot_then).push_back(k);
+        }
+        s.spring_step_s = spring_step_limit_s(s.springs, s.explicit_sets, s.paper_inv_mass);
         s.warp_rest_above = warp_rest_above(t);
         s.weft_rest_right = weft_rest_right(t);
         s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.band, parts.count);

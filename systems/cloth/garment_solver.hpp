@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "drape/components/garment.hpp"
@@ -69,6 +70,7 @@ struct PartScratch {
     std::vector<std::uint32_t> rows, lines;  ///< Repair: rows and lines its particles chose.
     std::vector<std::uint32_t> moved;        ///< Repair: particles its limits moved (in any part's lines).
     std::vector<std::uint32_t> collide;      ///< Repair: the moved particles of its lines, collided again.
+    std::vector<std::uint64_t> crushed;      ///< Repair: springs under the compression limit its particles found (a << 32 | b, a < b).
     std::vector<std::uint64_t> touched;      ///< Per particle of `collide`: its last_collided before that collision.
 };
 
@@ -93,8 +95,16 @@ struct GarmentSolver {
     VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
                                              ///< on its line (0 in the first row).
     Real drag_step_s = 0;                    ///< Largest stable step of the explicit drag.
+    // The paper's integrator only (ClothIntegrator::paper).
+    VectorX paper_inv_mass;                  ///< Per particle: a layer-1 particle of the simplified model with the mass
+                                             ///< of the weft particles placed from it (they have none, method §3.2).
+    std::vector<std::size_t> explicit_sets;  ///< Indices into `springs` whose forces are explicit (simplified: warp1).
+    std::vector<std::size_t> provot_first, provot_then; ///< Sets Provot's limit passes over: before layer 2 is placed
+                                             ///< from layer 1, and after (the simplified model's weft and layer-2 warp).
+    Real spring_step_s = std::numeric_limits<Real>::infinity(); ///< Largest stable step of the explicit springs.
 
     std::vector<EllipsoidFrame> frames;      ///< Colliders at the current substep, one per GarmentBody::colliders.
+    Real ground_m = -std::numeric_limits<Real>::infinity(); ///< The floor under the garment (collision.hpp ground_height).
     std::uint64_t frames_serial = 0;         ///< Counts the poses `frames` was given by the step (a new substep, a reset).
     std::vector<std::uint64_t> last_collided;///< Per particle: ellipsoids it was pushed out of last substep (temporal coherence).
     CandidateLists lists;
@@ -106,6 +116,7 @@ struct GarmentSolver {
     bool anchor_known = false;               ///< False: no step yet (the anchor's motion so far counts as none).
     double settled_s = 0;                    ///< Simulated time since the build or the last reset.
     bool settling = false;                   ///< In the first 1/6 s after the build or a reset (contact repair's larger round budget).
+    int repair_rounds_left = 384;            ///< Contact repair rounds left in this fixed step (set from ClothSolverSettings each step).
 
     // Scratch (no allocation per step once sized).
     Matrix3X x_start;                        ///< Positions at the start of the substep.
@@ -122,6 +133,7 @@ struct GarmentSolver {
     VectorX repair_slack_m;                  ///< Per particle collided in a repair round: how far its list still holds from where it is.
     std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
     std::vector<std::uint32_t> repair_rows, repair_lines; ///< The repair rounds' choices, all parts'.
+    std::vector<std::uint64_t> repair_crushed; ///< The repair rounds' springs under the compression limit, all parts'.
     std::vector<PartScratch> part_scratch;   ///< Per part.
     std::vector<std::uint32_t> weft_row_work; ///< Per weft row: springs the weft limit corrected in it last substep.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.

@@ -29,15 +29,16 @@ constexpr Real limit_share = Real(0.5);
 // follower's warp-limit move that its leader's velocity gives back.
 constexpr Real leader_damping = Real(0.9);
 
-// Contact repair (repair_pushes): at most this many rounds per substep, and the share of its
-// inverse mass a pushed particle keeps in them. For settling_s after the garment is built or
-// reset the budget is larger: the garment starts from its rest shape round a body already in
+// Contact repair (repair_pushes): its rounds come from the fixed step's budget
+// (ClothSolverSettings::repair_rounds_per_frame), shared out evenly over the substeps left;
+// pushed_weight is the share of its inverse mass a pushed particle keeps in them. For
+// settling_s after the garment is built or reset each substep may take at least
+// settling_repair_rounds: the garment starts from its rest shape round a body already in
 // the clip's pose of the moment, a hem across a bent knee, and falls onto the body (Robot-
 // Expressive's dress: 57 % after the first frame at 48 rounds, 10.0 % at 96; put on 0.375 s
 // into its walk, 70.2 % in its seventh frame with the larger budget in the first step only,
 // 10.0 % with it for 1/6 s). Later in a walk more rounds do not help (Female_Alternative's
 // skirt: 107 % at 48, 407 % at 96).
-constexpr int repair_rounds = 48;
 constexpr int settling_repair_rounds = 192;
 constexpr double settling_s = 1.0 / 6.0;
 constexpr Real pushed_weight = Real(0.1);
@@ -55,6 +56,7 @@ void begin_garment_step(const Registry& registry, Garment& g, GarmentSolver& s, 
     GarmentCounters& c = g.counters;
     c.frame_collision_tests = c.frame_collisions = c.frame_list_rebuild_tests = 0;
     c.max_penetration_m = 0;
+    c.frame_repair_rounds = 0;
     c.substeps = substeps;
     ++c.steps;
     update_pin_targets(registry, g, s, false);
@@ -94,6 +96,12 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
     const Vec3 gravity(0, -standard_gravity_m_s2, 0);
     const Real h = static_cast<Real>(sub.h_s);
     const bool carry = g.config.model == ClothModel::simplified;
+    // The paper's integrator: eq. 2's spring term first, at the start of the substep
+    // (integrator.hpp add_spring_impulses), on this thread (a spring's two ends may lie in
+    // different bands).
+    if (g.config.integrator == ClothIntegrator::paper)
+        for (const std::size_t k : s.explicit_sets)
+            add_spring_impulses(s.springs[k], state.x, s.paper_inv_mass, h, state.v);
     // Band by band (garment_parts.hpp).
     for_each_part(s.parts.count, [&](std::size_t k) {
         for (const ParticleRun& r : s.parts.runs[k]) {
@@ -127,11 +135,13 @@ bool collides_after(int round, int rounds) noexcept { return (rounds - 1 - round
 void prepare_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
     update_frames(registry, g.body, s.frames, Real(sub.index + 1) / Real(sub.count));
+    s.ground_m = ground_height(registry);
     ++s.frames_serial;
 }
 
 void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int round) {
     prepare_solver(g, s);
+    if (g.config.integrator == ClothIntegrator::paper) return;  // its springs are forces (integrate_garment)
     Matrix3X& x = g.state.x;
     const Real h = static_cast<Real>(sub.h_s);
     const Real limit = g.config.material.strain_limit;
@@ -165,6 +175,7 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
 
 void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSubstep&, int) {
     prepare_solver(g, s);
+    if (g.config.integrator == ClothIntegrator::paper) return;  // it collides once, after Provot (finish_collision)
     // The constraints moved the particles since the last round: the lists are brought up to
     // date for where they are now (only what moved far enough is refreshed, collision.hpp).
     const bool lists = g.config.collision == CollisionMode::candidate_lists;
@@ -176,6 +187,7 @@ void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSub
         for (const auto [first, end] : s.parts.runs[k]) {
             s.x_round.middleCols(first, end - first) = x.middleCols(first, end - first);
             collide_part(g, s, x, g.state.v, first, end, /*respond_velocity=*/false, c);
+            collide_ground(x, g.state.inv_mass, s.ground_m, first, end);
             for (Eigen::Index p = first; p < end; ++p) s.contacts[static_cast<std::size_t>(p)] |= s.last_collided[static_cast<std::size_t>(p)];
             s.push.middleCols(first, end - first) += x.middleCols(first, end - first) - s.x_round.middleCols(first, end - first);
         }
@@ -183,8 +195,48 @@ void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSub
     for (const PartCounters& c : s.part_counters) add_part_counters(g, c);
 }
 
-void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep&) {
+namespace {
+
+// The paper's constraints (method §4.1-§4.2): Provot's limit, `iterations` Gauss-Seidel
+// passes over layer 1's springs (the classic model: every structural spring), and Provot's
+// velocities following his corrections: an integrated particle moved by d gets d / h more.
+// The simplified model's layer 2 is then placed again from layer 1 where it now is
+// (weft.hpp), and Provot's passes go over the springs with layer-2 particles; a layer-2
+// particle, which has no velocity of its own, moves with its neighbours: its move over the
+// substep / h. Those passes move layer-1 ends too, but give them no velocity: their moves
+// answer layer 2's placement, not layer 1's motion, and a placement's d / h grows without
+// bound as h shrinks (docs/cloth.md "Two integrators": at 1e5-1e6 N/m, hundreds of
+// substeps, it pumped energy into the skirt until it diverged).
+void paper_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    Matrix3X& x = g.state.x;
+    const VectorX& w = g.state.inv_mass;
+    const Real limit = g.config.material.strain_limit;
+    const int passes = constraint_rounds(g);
+    const Real inv_h = static_cast<Real>(1 / sub.h_s);
+    s.x_round = x;  // after the prediction
+    for (int pass = 0; pass < passes; ++pass)
+        for (const std::size_t k : s.provot_first) (void)provot_pass(*s.springs[k].springs, w, limit, x);
+    for (Eigen::Index p = 0; p < s.integrated; ++p)
+        if (w[p] != 0) g.state.v.col(p) += (x.col(p) - s.x_round.col(p)) * inv_h;  // pins: their velocity is the skin's
+    if (g.config.model != ClothModel::simplified) return;
+    for (const std::uint32_t p : g.fabric->weft_particle)
+        if (w[p] != 0) x.col(p) = s.x_start.col(p);
+    for (std::size_t k = 0; k < s.parts.count; ++k) carry_weft(*g.fabric, s.parts.weft_entries[k], w, s.x_start, x);
+    carry_weft(*g.fabric, s.parts.edge_weft_entries, w, s.x_start, x);
+    for (int pass = 0; pass < passes; ++pass)
+        for (const std::size_t k : s.provot_then) (void)provot_pass(*s.springs[k].springs, w, limit, x);
+    for (Eigen::Index p = s.integrated; p < x.cols(); ++p)
+        if (w[p] != 0) g.state.v.col(p) = (x.col(p) - s.x_start.col(p)) * inv_h;
+}
+
+}  // namespace
+
+void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     prepare_solver(g, s);
+    if (g.config.integrator == ClothIntegrator::paper) {
+        paper_constraints(g, s, sub);
+        return;
+    }
     const Real stretch = limit_share * g.config.material.strain_limit;
     for_each_part(s.parts.count, [&](std::size_t k) {
         const auto [first_line, end_line] = s.parts.lines[k];
@@ -238,7 +290,7 @@ namespace {
 // - the warp limit's move of the particle below it on its line (follow the leader with the
 //   damping of dynamic follow-the-leader: the leader feels most of what it did to the
 //   follower, which a one-sided move would otherwise add as energy);
-// - where it touched an ellipsoid, the push-outs: across the surface it keeps the normal
+// - where it touched an ellipsoid or the floor, the push-outs: across the surface it keeps the normal
 //   velocity it had without them where that leaves the surface, else the surface's (no
 //   approach, method §5); along it, the motion relative to the surface slowed by Coulomb
 //   friction (shortened by `friction` x the approach removed, never reversed).
@@ -253,7 +305,8 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Ei
         const std::uint32_t below = s.below[static_cast<std::size_t>(p)];
         if (below != static_cast<std::uint32_t>(p)) moved -= leader_damping * inv_h * s.warp_moves.col(below);
         const std::uint64_t touched = s.contacts[static_cast<std::size_t>(p)];
-        if (touched == 0) {
+        const bool floor = on_ground(x.col(p), s.ground_m);
+        if (touched == 0 && !floor) {
             v.col(p) = moved;
             continue;
         }
@@ -272,6 +325,15 @@ void update_velocities(Garment& g, GarmentSolver& s, const ClothSubstep& sub, Ei
                 if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
             }
             vp = surface + tangential + std::max(away, Real(0)) * normal;
+        }
+        if (floor) {  // the floor: a surface at rest, its normal +Y
+            const Real away = unpushed.y();
+            Vec3 tangential(vp.x(), 0, vp.z());
+            if (away < 0) {
+                const Real t_len = tangential.norm();
+                if (t_len > 0) tangential *= std::max(Real(0), 1 + friction * away / t_len);
+            }
+            vp = tangential + Vec3(0, std::max(away, Real(0)), 0);
         }
         v.col(p) = vp;
     }
@@ -393,17 +455,104 @@ void collide_moved(Garment& g, GarmentSolver& s, std::size_t part) {
 }
 
 // `list` sorted, each entry once.
-void sort_unique(std::vector<std::uint32_t>& list) {
+template <class T>
+void sort_unique(std::vector<T>& list) {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
 }
 
 // The parts' lists in `out`, sorted, each once.
-void merge_sorted(std::vector<std::uint32_t>& out, const std::vector<PartScratch>& parts,
-                  std::vector<std::uint32_t> PartScratch::*list) {
+template <class T>
+void merge_sorted(std::vector<T>& out, const std::vector<PartScratch>& parts, std::vector<T> PartScratch::*list) {
     out.clear();
     for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
     sort_unique(out);
+}
+
+// Whether the spring p-q of rest length `rest` is shorter than `shortest` x it, and its key
+// in the repair's list of crushed springs (a << 32 | b, a < b).
+bool is_crushed(const Matrix3X& x, std::uint32_t p, std::uint32_t q, Real rest, Real shortest) {
+    return (x.col(q) - x.col(p)).squaredNorm() < shortest * shortest * rest * rest;
+}
+std::uint64_t spring_key(std::uint32_t p, std::uint32_t q) { return std::uint64_t(std::min(p, q)) << 32 | std::max(p, q); }
+
+// The springs of free particle p shorter than `shortest` x their rest length, appended to
+// `out` as a << 32 | b with a < b (contact repair's compression limit). Returns whether it
+// found any.
+bool find_crushed(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::uint32_t p, Real shortest,
+                  std::vector<std::uint64_t>& out) {
+    if (!(shortest > 0)) return false;
+    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+    const std::uint32_t line = s.grid_place[p] / m, row = s.grid_place[p] % m;
+    bool found = false;
+    const auto check = [&](std::uint32_t q, Real rest) {
+        if (!is_crushed(x, p, q, rest, shortest)) return;
+        out.push_back(spring_key(p, q));
+        found = true;
+    };
+    if (row > 0) check(s.above[p], s.warp_rest_above[p]);
+    if (row + 1 < m) check(s.below[p], s.warp_rest_above[s.below[p]]);
+    if (n > 1 && (line > 0 || f.closed)) {
+        const std::uint32_t q = f.grid[((line + n - 1) % n) * m + row];
+        check(q, s.weft_rest_right[q]);
+    }
+    if (n > 1 && (line + 1 < n || f.closed)) check(f.grid[((line + 1) % n) * m + row], s.weft_rest_right[p]);
+    return found;
+}
+
+// The springs shorter than `shortest` x their rest length with a free end whose first end
+// lies on the lines [first, end), appended to `out` as find_crushed gives them. Every spring
+// is looked at once (grid order: the spring to the particle below, then to the next line),
+// not only those of particles that moved: the limits' moves can crush a spring they do not
+// stretch, and so can the rounds (a collision putting two neighbours on one point of a
+// surface; in the classic model the shear and bend springs pressing a weft spring at the hem).
+void find_crushed_lines(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::pair<std::uint32_t, std::uint32_t> lines,
+                        Real shortest, std::vector<std::uint64_t>& out) {
+    if (!(shortest > 0)) return;
+    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+    const VectorX& w = s.inv_mass;
+    const auto check = [&](std::uint32_t p, std::uint32_t q, Real rest) {
+        if ((w[p] != 0 || w[q] != 0) && is_crushed(x, p, q, rest, shortest)) out.push_back(spring_key(p, q));
+    };
+    for (std::uint32_t line = lines.first; line < lines.second; ++line) {
+        const std::uint32_t* here = f.grid.data() + std::size_t(line) * m;
+        const bool right = n > 1 && (line + 1 < n || f.closed);
+        const std::uint32_t* next = f.grid.data() + std::size_t((line + 1) % n) * m;
+        for (std::uint32_t row = 0; row < m; ++row) {
+            const std::uint32_t p = here[row];
+            if (row + 1 < m) check(p, here[row + 1], s.warp_rest_above[here[row + 1]]);
+            if (right) check(p, next[row], s.weft_rest_right[p]);
+        }
+    }
+}
+
+// The springs of s.repair_crushed pushed apart to `target` x their rest length, their ends
+// sharing the move by the weights `w` (the point they weigh on stays), along their chord;
+// where the ends meet, along the chord at the substep's start. The particles moved go to
+// `moved`.
+void push_apart(const Fabric& f, const GarmentSolver& s, Matrix3X& x, const VectorX& w, Real target,
+                std::vector<std::uint32_t>& moved) {
+    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+    for (const std::uint64_t key : s.repair_crushed) {
+        const auto a = static_cast<std::uint32_t>(key >> 32), b = static_cast<std::uint32_t>(key);
+        const Real wsum = w[a] + w[b];
+        if (!(wsum > 0)) continue;
+        const std::uint32_t la = s.grid_place[a] / m, lb = s.grid_place[b] / m;
+        Real rest = 0;
+        if (la == lb)
+            rest = s.warp_rest_above[s.grid_place[a] % m > s.grid_place[b] % m ? a : b];
+        else
+            rest = (la + 1) % n == lb ? s.weft_rest_right[a] : s.weft_rest_right[b];
+        Vec3 d = x.col(b) - x.col(a);
+        if (d.norm() < Real(1e-3) * rest) d = s.x_start.col(b) - s.x_start.col(a);
+        if (d.norm() < Real(1e-3) * rest) d = Vec3::UnitY();
+        d.normalize();
+        const Vec3 centre = (w[b] * x.col(a) + w[a] * x.col(b)) / wsum;
+        x.col(a) = centre - (w[a] / wsum) * target * rest * d;
+        x.col(b) = centre + (w[b] / wsum) * target * rest * d;
+        if (w[a] != 0) moved.push_back(a);
+        if (w[b] != 0) moved.push_back(b);
+    }
 }
 
 // Contact repair (an extension of method §4.1-§5, docs/cloth.md "Contact repair"): the last
@@ -414,18 +563,23 @@ void merge_sorted(std::vector<std::uint32_t>& out, const std::vector<PartScratch
 // limited again, a particle pushed in this substep taken as heavier (inverse mass x
 // pushed_weight) so that the limits move its neighbours toward it rather than it back into
 // the body; then what they moved is collided again. Until no spring of a moved particle is
-// over the limit, or repair_rounds rounds (settling_repair_rounds while settling).
+// over the limit, or the substep's share of the fixed step's round budget (at least
+// settling_repair_rounds while settling; the budget binding is counted in budget_hits).
 // Each stage of a round runs in parts at the same time, on particles no other part touches:
 // the check of the moved particles, the warp limit on a share of the listed lines, the weft
 // limit on a share of the listed rows, the collision of what they moved by line (line number
 // modulo the parts: a particle and the one above it on its line, toward which the
 // collision's fallback may move it, in the same part, in index order). The result is the
 // same bytes on any number of threads.
-void repair_pushes(Garment& g, GarmentSolver& s) {
+void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     const Fabric& f = *g.fabric;
     const std::uint32_t m = f.particles_per_line;
     const Real limit = g.config.material.strain_limit;
     const Real stretch = limit_share * limit;
+    // The compression limit as the strain limit: a spring shorter than it is chosen, and
+    // pushed apart to within limit_share of it.
+    const Real shortest = g.config.material.compression_limit;
+    const Real apart = 1 - limit_share * (1 - shortest);
     const std::size_t parts = s.parts.count;
     Matrix3X& x = g.state.x;
     // Moved by the last limits: first, those the weft limit moved. The warp limit leaves no
@@ -441,26 +595,38 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
     });
     s.repair_inv_mass = s.inv_mass;  // the pushed particles chosen are made heavier below
     const VectorX& w = s.repair_inv_mass;
-    const int rounds = s.settling ? settling_repair_rounds : repair_rounds;
-    for (int round = 0; round < rounds; ++round) {
+    const int substeps_left = std::max(1, sub.count - sub.index);
+    int rounds = (s.repair_rounds_left + substeps_left - 1) / substeps_left;
+    if (s.settling) rounds = std::max(rounds, settling_repair_rounds);
+    for (int round = 0;; ++round) {
         for_each_part(parts, [&](std::size_t k) {
             PartScratch& ps = s.part_scratch[k];
             ps.rows.clear();
             ps.lines.clear();
+            ps.crushed.clear();
             const auto choose = [&](std::uint32_t p) {
                 const int springs = over_limit(f, s, x, p, limit);
                 if (springs & 1) ps.lines.push_back(s.grid_place[p] / m);
                 if (springs & 2) ps.rows.push_back(s.grid_place[p] % m);
-                return springs != 0;
+                const bool crushed = find_crushed(f, s, x, p, shortest, ps.crushed);
+                return springs != 0 || crushed;
             };
             for (const std::uint32_t p : s.pushed[k])
                 if (choose(p)) s.repair_inv_mass[p] = s.inv_mass[p] * pushed_weight;
             for (const std::uint32_t p : ps.collide) choose(p);
+            if (round == 0) find_crushed_lines(f, s, x, s.parts.lines[k], shortest, ps.crushed);
         });
         merge_sorted(s.repair_rows, s.part_scratch, &PartScratch::rows);
         merge_sorted(s.repair_lines, s.part_scratch, &PartScratch::lines);
-        if (s.repair_rows.empty() && s.repair_lines.empty()) return;
+        merge_sorted(s.repair_crushed, s.part_scratch, &PartScratch::crushed);
+        if (s.repair_rows.empty() && s.repair_lines.empty() && s.repair_crushed.empty()) return;
+        if (round == rounds) {  // the budget binds: springs are left over (or under) the limit
+            ++g.counters.budget_hits;
+            return;
+        }
         ++g.counters.repair_rounds;
+        ++g.counters.frame_repair_rounds;
+        s.repair_rounds_left = std::max(0, s.repair_rounds_left - 1);
         // What the limits move is collided again and looked at in the next round; the moves
         // go back to zero.
         const auto take = [](Matrix3X& moves, std::uint32_t p, std::vector<std::uint32_t>& moved) {
@@ -490,6 +656,8 @@ void repair_pushes(Garment& g, GarmentSolver& s) {
             for (const std::uint32_t row : rows)
                 for (std::uint32_t line = 0; line < f.warp_lines; ++line) take(s.repair_weft_moves, f.grid[line * m + row], ps.moved);
         });
+        // The crushed springs (few), on this thread.
+        push_apart(f, s, x, w, apart, s.part_scratch[0].moved);
         for_each_part(parts, [&](std::size_t k) {
             PartScratch& ps = s.part_scratch[k];
             ps.collide.clear();
@@ -511,8 +679,32 @@ bool all_finite(const M& m) {
 
 }  // namespace
 
-void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
-    prepare_solver(g, s);
+namespace {
+
+// The paper's collision (method §5), once per substep after Provot: every particle in the
+// garment's collision mode out of the ellipsoids to where the line from the centre meets
+// the surface, its velocity toward the surface (relative to its motion) removed, friction
+// as the material gives it (the paper names none); the floor the same.
+void paper_collision(Garment& g, GarmentSolver& s) {
+    const bool lists = g.config.collision == CollisionMode::candidate_lists;
+    if (lists) prepare_candidate_lists(g, s);
+    Matrix3X& x = g.state.x;
+    Matrix3X& v = g.state.v;
+    for_each_part(s.parts.count, [&](std::size_t k) {
+        PartCounters& c = s.part_counters[k] = PartCounters{};
+        if (lists) update_candidate_part(g, s, k, c);
+        for (const auto [first, end] : s.parts.runs[k]) {
+            collide_part(g, s, x, v, first, end, /*respond_velocity=*/true, c);
+            collide_ground(x, g.state.inv_mass, s.ground_m, first, end);
+            for (Eigen::Index p = first; p < end; ++p)
+                if (g.state.inv_mass[p] != 0 && on_ground(x.col(p), s.ground_m)) v(1, p) = std::max(v(1, p), Real(0));
+            c.finite = c.finite && all_finite(x.middleCols(first, end - first)) && all_finite(v.middleCols(first, end - first));
+        }
+    });
+}
+
+// The shipped solver's end of a substep (finish_collision).
+void shipped_collision(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     // The lists are sized on this thread first when a limit moved anything.
     const bool moved = std::any_of(s.part_counters.begin(), s.part_counters.end(),
                                    [](const PartCounters& c) { return c.warp_moved > 0 || c.weft_moved > 0; });
@@ -522,15 +714,27 @@ void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, co
         s.pushed[k].clear();
         if (moved) collide_limit_moves(g, s, k, c);
     });
-    if (moved) repair_pushes(g, s);
+    // Without a limit's move the repair still looks for crushed springs (the rounds' own).
+    if (moved || g.config.material.compression_limit > 0) repair_pushes(g, s, sub);
     for_each_part(s.parts.count, [&](std::size_t k) {
         PartCounters& c = s.part_counters[k];
         for (const auto [first, end] : s.parts.runs[k]) {
+            collide_ground(g.state.x, g.state.inv_mass, s.ground_m, first, end, &s.push);
             update_velocities(g, s, sub, first, end);
             c.finite = c.finite && all_finite(g.state.x.middleCols(first, end - first)) &&
                        all_finite(g.state.v.middleCols(first, end - first));
         }
     });
+}
+
+}  // namespace
+
+void finish_collision(const Registry& registry, Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
+    prepare_solver(g, s);
+    if (g.config.integrator == ClothIntegrator::paper)
+        paper_collision(g, s);
+    else
+        shipped_collision(g, s, sub);
     bool finite = true;
     for (const PartCounters& c : s.part_counters) {
         add_part_counters(g, c);
@@ -596,6 +800,8 @@ void reset_garment_state(const Registry& registry, Garment& g, GarmentSolver& s)
     s.lists.valid = false;
     s.anchor_known = false;
     collide_garment(g, s);
+    s.ground_m = ground_height(registry);
+    collide_ground(state.x, state.inv_mass, s.ground_m, 0, n);
     ++g.counters.resets;
 }
 

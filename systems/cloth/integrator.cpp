@@ -2,6 +2,7 @@
 #include "drape/systems/cloth/integrator.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace drape {
@@ -13,12 +14,12 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
         // The particles feel all of the frame's motion: its inertial and fictitious forces
         // cancel the frame's own motion, and the motion in the frame is the motion in the
         // world. Integrated there directly: the same scheme without the frame changes.
-        const Vec3 drag_body_offset = f.acceleration_m_s2 * (h / 2);  // eq. 2: v_b + a_b h / 2
+        // Still air: the drag acts on the world velocity.
         for (Eigen::Index i = first; i < end; ++i) {
             const Real inv_m = inv_mass[i];
             if (inv_m == 0) continue;  // pinned: follows the skin (method §3.5)
             const Vec3 vi = v.col(i);
-            const Vec3 v_new = vi + h * (g - (drag[i] * inv_m) * (vi + drag_body_offset));
+            const Vec3 v_new = vi + h * (g - (drag[i] * inv_m) * vi);
             v.col(i) = v_new;
             x.col(i) += h * v_new;
         }
@@ -30,8 +31,8 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
     // The inertial impulse of the frame's change of motion since the velocities were written.
     const Vec3 linear_kick = inertia.linear * (f.velocity_m_s - f.velocity_before_m_s);
     const Vec3 angular_kick = inertia.angular * (w - w_before);
-    const Vec3 drag_body_offset = f.acceleration_m_s2 * (h / 2);  // eq. 2: v_b + a_b h / 2
-    const Real s_ang = inertia.angular;
+    const Real s_lin = inertia.linear, s_ang = inertia.angular;
+    const Vec3 air_linear = (1 - s_lin) * f.velocity_before_m_s, air_angular = (1 - s_ang) * w_before;
     for (Eigen::Index i = first; i < end; ++i) {
         const Real inv_m = inv_mass[i];
         if (inv_m == 0) continue;  // pinned: follows the skin (method §3.5)
@@ -39,14 +40,47 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
         const Vec3 d = x.col(i) - f.c0;
         const Vec3 r = r0t * d;
         Vec3 u = r0t * (vi - f.velocity_before_m_s - w_before.cross(d) - linear_kick - angular_kick.cross(d));
-        // Drag: -k (v_b + a_b h/2) - k (v - v_b) = -k (v + a_b h/2), in the world.
-        const Vec3 forces = g - (drag[i] * inv_m) * (vi + drag_body_offset);
+        // Drag against the air, which moves with the share of the frame's motion the
+        // particle does not feel: -k (v - (1 - s_lin) V - (1 - s_ang) W x d).
+        const Vec3 forces = g - (drag[i] * inv_m) * (vi - air_linear - air_angular.cross(d));
         const Vec3 fictitious = s_ang * (2 * w_local.cross(u) + w_local.cross(w_local.cross(r)));
         u += h * (r0t * forces - fictitious);
         const Vec3 x_new = f.r1 * (r + h * u) + f.c1;
         x.col(i) = x_new;
         v.col(i) = f.r1 * u + f.velocity_m_s + w.cross(x_new - f.c1);
     }
+}
+
+void add_spring_impulses(const SpringSet& set, const Matrix3X& x, const VectorX& w, Real h, Matrix3X& v) {
+    const SpringPhase& sp = *set.springs;
+    const std::vector<Real>& compliance = set.compliance;
+    for (std::size_t s = 0; s < sp.size(); ++s) {
+        const std::uint32_t a = sp.a[s], b = sp.b[s];
+        const Real wa = w[a], wb = w[b];
+        if (wa == 0 && wb == 0) continue;
+        const Vec3 d = x.col(b) - x.col(a);
+        const Real len = d.norm();
+        if (!(len > 0)) continue;
+        const Vec3 impulse = (h * (len - sp.rest_m[s]) / (compliance[s] * len)) * d;  // h F on a, toward b when stretched
+        v.col(a) += wa * impulse;
+        v.col(b) -= wb * impulse;
+    }
+}
+
+Real spring_step_limit_s(std::span<const SpringSet> sets, std::span<const std::size_t> which, const VectorX& w) {
+    VectorX row = VectorX::Zero(w.size());
+    for (const std::size_t k : which) {
+        const SpringPhase& sp = *sets[k].springs;
+        for (std::size_t s = 0; s < sp.size(); ++s) {
+            const std::uint32_t a = sp.a[s], b = sp.b[s];
+            const Real stiffness = 1 / sets[k].compliance[s];
+            const Real across = stiffness * std::sqrt(w[a] * w[b]);
+            row[a] += stiffness * w[a] + across;
+            row[b] += stiffness * w[b] + across;
+        }
+    }
+    const Real lambda = row.size() > 0 ? row.maxCoeff() : Real(0);
+    return lambda > 0 ? 2 / std::sqrt(lambda) : std::numeric_limits<Real>::infinity();
 }
 
 Real drag_step_limit_s(const VectorX& inv_mass, const VectorX& drag, Eigen::Index count) {

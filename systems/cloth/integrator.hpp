@@ -9,12 +9,16 @@
 //   goes from (R0, c0) to (R1, c1).
 // - A particle's place and velocity relative to the frame: r = R0^T (x - c0),
 //   u = R0^T (v - V_prev - W_prev x (x - c0)). Paper eq. 2 in that frame:
-//       m du/dt = -m s_lin a_b - k (v_b + a_b h/2) - k v_rel + m g
+//       m du/dt = -m s_lin a_b - k (v - v_air) + m g
 //                 - m s_ang (2 W x u + W x (W x r) + dW/dt x r)
-//   with v_b = V + W x (x - c0) the body's velocity at the particle, a_b the anchor's
-//   acceleration, k the particle's air drag (material drag per area x its area), and the
-//   inertia scales s_lin, s_ang (InertiaScales: 1 is physical, 0 carries the particle
-//   rigidly with the frame). The frame's velocity changes once per fixed step, so the
+//   with k the particle's air drag (material drag per area x its area) and the inertia
+//   scales s_lin, s_ang (InertiaScales: 1 is physical, 0 carries the particle rigidly with
+//   the frame). The air moves with the share of the frame's motion the particle does not
+//   feel, v_air = (1 - s_lin) V + (1 - s_ang) W x (x - c0): still air at 1, the frame's own
+//   motion at 0 (so that a garment at rest on a body that only moves stays at rest on it).
+//   The paper's drag, -k (v_b + a_b h/2) - k v_rel, is -k (v + a_b h/2) with both scales 1:
+//   its a_b h/2 is a step-size artefact (a force that depends on the body's acceleration
+//   and on h), left out here. The frame's velocity changes once per fixed step, so the
 //   inertial terms -m s_lin a_b and -m s_ang dW/dt x r act as the impulse
 //   -s_lin (V - V_prev) - s_ang (W - W_prev) x (x - c0) at the step's first substep.
 // - Symplectic Euler: u += h du/dt, r += h u; then back to the world with the frame at the
@@ -25,8 +29,11 @@
 // Pinned particles (inverse mass 0) are left to the pins.
 #pragma once
 
+#include <span>
+
 #include "drape/components/garment.hpp"
 #include "drape/engine/core/math.hpp"
+#include "drape/systems/cloth/constraints.hpp"
 
 namespace drape {
 
@@ -38,13 +45,28 @@ struct AnchorMotion {
     Vec3 angular_velocity_rad_s = Vec3::Zero();         ///< W.
     Vec3 velocity_before_m_s = Vec3::Zero();            ///< V_prev.
     Vec3 angular_velocity_before_rad_s = Vec3::Zero();  ///< W_prev.
-    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b (eq. 2's drag term).
+    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b; the prediction does not read it (its inertial term acts through V - V_prev, and the drag no longer takes a_b h/2: docs/cloth.md, Integration).
 };
 
 /// Prediction of particles [first, end): `drag` is each particle's k (N s/m).
 void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const VectorX& drag_N_s_m,
                        Eigen::Index first, Eigen::Index end, const AnchorMotion& anchor, const InertiaScales& inertia,
                        const Vec3& gravity_m_s2, Real h_s);
+
+/// Eq. 2's spring term (method §3.3), for the paper's integrator: Hooke's force
+/// k (|d| - L) d / |d| of each spring of `set` (k = 1 / its compliance) at positions `x`,
+/// given to both ends' velocities as h F inv_mass (pinned ends, inverse mass 0, keep theirs).
+/// Added before predict_particles, whose velocity update then takes the rest of eq. 2: the
+/// spring force at the start of the step, symplectic Euler (method §3.4).
+void add_spring_impulses(const SpringSet& set, const Matrix3X& x, const VectorX& inv_mass, Real h_s, Matrix3X& v);
+
+/// Largest step for which symplectic Euler on the springs of `sets` listed in `which` stays
+/// bounded (method §3.4):
+/// 2 / sqrt(lambda), lambda a bound on the largest eigenvalue of M^-1 K (Gershgorin on
+/// M^-1/2 K M^-1/2: over the particles, sum of k / m_i + sum of k / sqrt(m_i m_j) over its
+/// springs; a stretched spring's sideways stiffness is below k). +inf without springs.
+[[nodiscard]] Real spring_step_limit_s(std::span<const SpringSet> sets, std::span<const std::size_t> which,
+                                       const VectorX& inv_mass);
 
 /// Largest step for which the explicit drag of eq. 2 stays stable: min over particles of m / k.
 [[nodiscard]] Real drag_step_limit_s(const VectorX& inv_mass, const VectorX& drag_N_s_m, Eigen::Index count);

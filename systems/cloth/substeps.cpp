@@ -44,13 +44,17 @@ int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver
                      const ClothSolverSettings& s) {
     if (!g.fabric) return 1;
     prepare_solver(g, solver);
+    solver.repair_rounds_left = std::max(0, s.repair_rounds_per_frame);
     if (s.fixed_substeps > 0) {
         g.counters.substeps_stability = g.counters.substeps_motion = s.fixed_substeps;
         return s.fixed_substeps;
     }
     const double cap = std::max(1, s.max_substeps);
-    const double h_stable = double(solver.drag_step_s) * s.stability_safety;
-    const double stability = h_stable > 0 ? std::ceil(fixed_dt / h_stable) : cap;  // +inf: no bound, one substep
+    const bool paper = g.config.integrator == ClothIntegrator::paper;
+    const double stability_cap = paper ? std::max(cap, double(s.max_stability_substeps)) : cap;
+    const double h_bound = paper ? std::min(double(solver.drag_step_s), double(solver.spring_step_s)) : double(solver.drag_step_s);
+    const double h_stable = h_bound * s.stability_safety;
+    const double stability = h_stable > 0 ? std::ceil(fixed_dt / h_stable) : stability_cap;  // +inf: no bound, one substep
 
     // Fastest collider surface the garment can touch, relative to its anchor.
     double speed = 0;
@@ -81,7 +85,7 @@ int garment_substeps(const Registry& registry, Garment& g, GarmentSolver& solver
     }
     const double motion = s.max_surface_travel_m > 0 ? std::ceil(fixed_dt * speed / s.max_surface_travel_m) : 1;
 
-    g.counters.substeps_stability = static_cast<int>(std::clamp(stability, 1.0, cap));
+    g.counters.substeps_stability = static_cast<int>(std::clamp(stability, 1.0, stability_cap));
     g.counters.substeps_motion = static_cast<int>(std::clamp(motion, 1.0, cap));
     return std::max(g.counters.substeps_stability, g.counters.substeps_motion);
 }

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "bench/stability_bench.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 
 namespace drape::bench {
 namespace {

@@ -1,11 +1,13 @@
 // Sampling, composing and playing clips (method §1.1).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "drape/components/animation_player.hpp"
 #include "drape/components/skeleton.hpp"
 #include "drape/components/transform.hpp"
+#include "drape/engine/assets/character_import.hpp"
 #include "drape/systems/character/animation.hpp"
 #include "drape/systems/character/pose.hpp"
 
@@ -43,6 +45,96 @@ std::shared_ptr<AnimationClip> bend_and_walk() {
     root.positions = {Vec3(0, 0, 0), Vec3(0, 0, 2)};
     c->channels = {child, root};
     return c;
+}
+
+// A run cycle as exports often give it: keys at 30 per second, the child swinging
+// 0 -> 40 -> 0 degrees about X but ending 6.3 degrees off where it started, and the root
+// travelling 1.2 m forward while bobbing, ending 2 cm lower than it started.
+std::shared_ptr<AnimationClip> near_loop_run() {
+    auto c = std::make_shared<AnimationClip>();
+    c->name = "Run";
+    c->duration_s = 0.7;
+    BoneChannel child, root;
+    child.bone = 1;
+    root.bone = 0;
+    constexpr int keys = 22;  // 0 .. 0.7 s
+    constexpr double degree = M_PI / 180;
+    for (int k = 0; k < keys; ++k) {
+        const double u = double(k) / (keys - 1);
+        const double angle = 40 * degree * std::sin(M_PI * u) + 6.3 * degree * u;
+        child.rotation_times_s.push_back(float(c->duration_s * u));
+        child.rotations.emplace_back(Eigen::AngleAxis<Real>(Real(angle), Vec3::UnitX()));
+        root.position_times_s.push_back(float(c->duration_s * u));
+        root.positions.emplace_back(0, Real(0.05 * std::sin(2 * M_PI * u) - 0.02 * u), Real(1.2 * u));
+    }
+    c->channels = {child, root};
+    return c;
+}
+
+// Played as a loop, a near-loop's seam is blended: the pose at the clip's end is its
+// first pose, the poses just before the end step no further than the keys do elsewhere,
+// the travel stays the cycle's, and the first part of the clip is untouched. Played
+// once, it is sampled as the file gives it.
+TEST(ClipSampling, ANearLoopLoopsWithItsSeamBlended) {
+    auto s = chain();
+    auto clip = near_loop_run();
+    compute_clip_travel(*clip, *s);
+    blend_loop_seam(*clip);
+    ASSERT_GT(clip->seam_blend_s, 0);
+    ASSERT_LE(clip->seam_blend_s, 0.2);
+    EXPECT_NEAR(clip->travel_m.z(), 1.2f, 1e-5f);
+    std::vector<Affine3> local, start;
+    sample_clip(*clip, *s, 0, true, start, true);
+    sample_clip(*clip, *s, clip->duration_s, true, local, true);
+    EXPECT_LT(Quat(local[1].linear()).angularDistance(Quat(start[1].linear())), 1e-4f);
+    EXPECT_LT((local[0].translation() - start[0].translation()).norm(), 1e-5f);
+    // Without the seam the end is 6.3 degrees and 2 cm off.
+    sample_clip(*clip, *s, clip->duration_s, true, local, false);
+    EXPECT_GT(Quat(local[1].linear()).angularDistance(Quat(start[1].linear())), 0.1f);
+    EXPECT_GT((local[0].translation() - start[0].translation()).norm(), 0.019f);
+    // Across the wrap and through the blend, no step is larger than the largest step
+    // elsewhere plus the blend's own steepest share of the 6.3 degrees (smoothstep: 1.5 x
+    // the mean rate over the blend), in 1/120 s steps.
+    auto pose_at = [&](double t) {
+        std::vector<Affine3> p;
+        sample_clip(*clip, *s, t, true, p, true);
+        return p;
+    };
+    auto step = [&](double a, double b) {
+        const auto pa = pose_at(a), pb = pose_at(b);
+        return Quat(pa[1].linear()).angularDistance(Quat(pb[1].linear()));
+    };
+    Real worst_before = 0, worst_seam = 0;
+    const double dt = 1.0 / 120;
+    for (double t = 0; t + dt < clip->duration_s - clip->seam_blend_s; t += dt) worst_before = std::max(worst_before, step(t, t + dt));
+    for (double t = clip->duration_s - clip->seam_blend_s; t + dt <= clip->duration_s + 1e-9; t += dt)
+        worst_seam = std::max(worst_seam, step(t, t + dt));
+    worst_seam = std::max(worst_seam, step(clip->duration_s, 0));  // the wrap itself
+    const Real gap = Real(6.3 * M_PI / 180);
+    EXPECT_LE(worst_seam, worst_before + Real(1.5 * dt / clip->seam_blend_s) * gap + 1e-5f);
+    EXPECT_LT(step(clip->duration_s, 0), 1e-4f);
+    // Before the blend: the file's pose.
+    const double early = 0.3;
+    std::vector<Affine3> blended, as_given;
+    sample_clip(*clip, *s, early, true, blended, true);
+    sample_clip(*clip, *s, early, true, as_given, false);
+    EXPECT_TRUE(blended[1].isApprox(as_given[1], 1e-6f));
+    EXPECT_TRUE(blended[0].isApprox(as_given[0], 1e-6f));
+}
+
+// A clip that goes somewhere (ends 40 degrees off) gets no seam; one whose ends meet needs none.
+TEST(ClipSampling, OnlyANearLoopGetsASeam) {
+    auto s = chain();
+    auto far = bend_and_walk();  // the child ends 90 degrees off
+    compute_clip_travel(*far, *s);
+    blend_loop_seam(*far);
+    EXPECT_EQ(far->seam_blend_s, 0);
+    auto closed = near_loop_run();
+    closed->channels[0].rotations.back() = closed->channels[0].rotations.front();
+    closed->channels[1].positions.back() = closed->channels[1].positions.front() + Vec3(0, 0, 1.2f);
+    compute_clip_travel(*closed, *s);
+    blend_loop_seam(*closed);
+    EXPECT_EQ(closed->seam_blend_s, 0);
 }
 
 TEST(ClipSampling, SamplingAtAKeyReturnsTheKey) {

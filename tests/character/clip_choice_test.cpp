@@ -65,6 +65,20 @@ TEST(DefaultClip, WithoutAWalkALoopingLocomotionClip) {
     EXPECT_EQ(chosen(with_clips({clip("Jog", 1.0f), clip("Idle")})), "Idle");
 }
 
+// Exports of a cycle often end a few degrees off their first pose: a looping run whose ends
+// differ by 6.3 degrees is a run (not passed over for an idle), one whose ends differ by
+// 40 degrees goes somewhere else and is not.
+TEST(DefaultClip, ARunWhoseEndsNearlyMeetLoops) {
+    constexpr float degree = float(M_PI / 180);
+    EXPECT_EQ(chosen(with_clips({clip("Idle"), clip("Run", 6.3f * degree)})), "Run");
+    EXPECT_EQ(chosen(with_clips({clip("Idle"), clip("Run", 14 * degree)})), "Run");
+    EXPECT_EQ(chosen(with_clips({clip("Idle"), clip("Run", 40 * degree)})), "Idle");
+    const auto run = with_clips({clip("Idle"), clip("Run", 6.3f * degree)});
+    EXPECT_FALSE(choose_default_clip(run)->fell_back);
+    EXPECT_TRUE(choose_default_clip(with_clips({clip("Idle"), clip("Wave")}))->fell_back);
+    EXPECT_NEAR(loop_mismatch_rad(*clip("Run", 6.3f * degree)), 6.3f * degree, 1e-5f);
+}
+
 TEST(DefaultClip, ThenAnIdleThenTheFirstClip) {
     const CharacterAsset idle = with_clips({clip("Wave"), clip("Breathing_Idle")});
     EXPECT_EQ(choose_default_clip(idle)->reason, "Breathing_Idle (no walk or locomotion clip; name says idle)");

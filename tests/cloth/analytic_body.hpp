@@ -24,6 +24,7 @@ struct WalkSettings {
     double forward_speed_m_s = 1.2;
     double yaw_rad = 0.08;        ///< Pelvis yaw amplitude.
     double phase_s = 0;           ///< Time offset (different avatars, different phases).
+    double spin_rad_s = 0;        ///< The whole body turning about the vertical (a spin in place).
     Vec3 origin = Vec3::Zero();
 };
 
@@ -91,7 +92,7 @@ private:
 
     std::vector<Affine3> poses(double t) const {
         const double w = 2 * std::numbers::pi / m_walk.period_s;
-        const Real yaw = Real(m_walk.yaw_rad * std::sin(w * t));
+        const Real yaw = Real(m_walk.yaw_rad * std::sin(w * t) + m_walk.spin_rad_s * t);
         const Real bob = Real(0.02 * std::cos(2 * w * t));
         const Mat3 body_rot = Eigen::AngleAxis<Real>(yaw, Vec3::UnitY()).toRotationMatrix();
         const Vec3 root = m_walk.origin + Vec3(0, bob, Real(m_walk.forward_speed_m_s * t));

@@ -22,13 +22,13 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
         EXPECT_LT(spec.range.min, spec.range.max) << spec.name;
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
-    // Every ClothMaterial field a garment carries is a row (9 of them), and so is every
+    // Every ClothMaterial field a garment carries is a row (10 of them), and so is every
     // numeric field of TubeParams (14, the inertia scales, the hem clearance and the line
     // spacing included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
-    EXPECT_EQ(material, 9);
-    EXPECT_EQ(garment_parameters().size(), 24u);
+    EXPECT_EQ(material, 10);
+    EXPECT_EQ(garment_parameters().size(), 25u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {

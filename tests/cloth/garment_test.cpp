@@ -192,7 +192,7 @@ TEST(Pins, SkinnedPinsFollowLinearBlendSkinningOfTheSkin) {
         const Real w = Real(0.5) + Real(0.5) * std::sin(a);
         mesh->bone_weights.col(i) << w, 1 - w, 0, 0;
     }
-    registry.emplace<SkinnedMesh>(character, SkinnedMesh{mesh, {}, {}});
+    registry.emplace<SkinnedMesh>(character, SkinnedMesh{mesh, {}, {}, 0, {}});
     // Colliders: a pelvis and a torso on the bones, placed in world space.
     for (int bone = 0; bone < 2; ++bone) {
         EllipsoidCollider c;

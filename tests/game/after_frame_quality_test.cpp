@@ -2,6 +2,9 @@
 // as the stats contract measures it: no free particle inside an ellipsoid, pinned points
 // outside, nothing flung above the pins, nothing non-finite, no reset, and the structural
 // strain where the model holds it (docs/cloth.md, "Known limits", lists what it does not).
+// The ellipsoid depths hold by construction (the last move of a substep is a push-out), so
+// the cloth is also judged on what the solver does not force: how deep it lies behind the
+// skin mesh a user sees (game/skin_penetration.hpp) and how far its springs are crushed.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -18,7 +21,10 @@ GarmentStats walk(GarmentType type, ClothModel model, int frames) {
     SceneDescription scene = sample_scene();
     scene.garments.at(0).type = type;
     scene.garments.at(0).model = model;
-    auto world = build_world(scene, {});
+    WorldOptions options;
+    options.skin_penetration = true;
+    options.skin_penetration_every = 5;  // a fifth of the measuring (the dress: 10,080 particles, 600 frames)
+    auto world = build_world(scene, options);
     EXPECT_TRUE(world) << (world ? "" : world.error().message);
     if (!world) return {};
     for (int frame = 0; frame < frames; ++frame) EXPECT_TRUE(step_world(*world, 1.0 / 60.0));
@@ -38,6 +44,17 @@ void expect_clean(const GarmentStats& g) {
 
 // Clean, and the structural strain within the contract (p99 <= 10 %, max <= 15 %), over 600
 // frames of the walk. Labelled `figures`: the short form asserts only that it runs clean.
+// Behind the skin, measured over those frames (release build, AMD
+// EPYC): the skirts 1.0-4.0 % of their free particles, at most 9.2 and 9.8 mm deep (the
+// simplified and the classic model), the dresses 1.1-1.9 %, 13.9 and 14.9 mm; the bounds
+// below are a guard against getting worse, a third above those, not the contract's 2 mm,
+// which the cloth does not keep on the skin (docs/cloth.md, "Quality after a frame").
+// Compressed: no spring shorter than the contract's 25 % of its rest length. The skirts'
+// shortest keeps 62-73 % of its length; the dresses' were crushed to 1.3 % and 0.4 % (a
+// collision putting two neighbours on one point of the surface, shear and bend springs
+// pressing the hem) before contact repair held the material's compression limit (25 %) as
+// it holds the strain limit: this fails where the repair's budget binds or anything after
+// it crushes a spring.
 void expect_contract(GarmentType type, ClothModel model) {
     const GarmentStats g = walk(type, model, test::frames(600));
     EXPECT_EQ(g.nonfinite, 0u);
@@ -45,6 +62,10 @@ void expect_contract(GarmentType type, ClothModel model) {
     expect_clean(g);
     EXPECT_LE(g.strain_p99, 0.10);
     EXPECT_LE(g.strain_max, 0.15);
+    ASSERT_TRUE(g.skin_measured);
+    EXPECT_LE(g.skin_penetration_share, 0.055);
+    EXPECT_LE(g.skin_penetration_max_m, type == GarmentType::skirt ? 0.013 : 0.02);
+    EXPECT_GE(g.compression_min, 0.25);
 }
 
 TEST(AfterFrameQuality, SimplifiedSkirtOnTheWalk) { expect_contract(GarmentType::skirt, ClothModel::simplified); }

@@ -4,6 +4,7 @@
 // the pinned points stay outside the ellipsoids; a long dress is shortened on a short body.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "drape/components/body_landmarks.hpp"
@@ -12,8 +13,10 @@
 #include "drape/components/transform.hpp"
 #include "drape/game/avatar_generator.hpp"
 #include "drape/game/sample_scene.hpp"
+#include "drape/game/skin_penetration.hpp"
 #include "drape/game/world.hpp"
 #include "drape/systems/character/body_landmarks.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 #include "drape/systems/cloth/garment_quality.hpp"
 #include "tests/shared_assets.hpp"
 #include "tests/test_paths.hpp"
@@ -100,6 +103,7 @@ Hem hem(const fs::path& file, GarmentType type, double clearance = -1) {
     scene.characters.at(0).file = file;
     scene.garments.at(0).type = type;
     if (clearance >= 0) scene.garments.at(0).parameters.push_back({"hem_clearance_fraction", clearance});
+    scene.ground = false;  // the cut, not the floor a hem reaching it would lie on (ground_test.cpp)
     auto world = build_world(scene, {});
     EXPECT_TRUE(world) << (world ? "" : world.error().message);
     Hem out;
@@ -134,21 +138,34 @@ TEST(GarmentPlacement, ALongDressIsShortenedOnAShortBody) {
     EXPECT_NEAR(shortened.high, unlimited.high, 1e-3f) << "the ring stays where it was";
 }
 
-// Fitting-zone points sit on or outside the ellipsoids after every frame of the walk, also
-// where an arm's ellipsoid hangs against the chest at a dress's ring.
-TEST(GarmentPlacement, PinsStayOutsideTheEllipsoidsOnTheWalk) {
+// Fitting-zone points lie on the skin they are pinned to (method §3.5), after every frame
+// of the walk, also where an arm's ellipsoid hangs against the chest at a dress's ring:
+// within a garment's ease of the skin mesh, never behind it. (Pins outside the ellipsoids
+// hold by construction: pins.cpp pushes their targets out of them first.)
+TEST(GarmentPlacement, PinsStayOnTheSkinOnTheWalk) {
     for (GarmentType type : {GarmentType::skirt, GarmentType::dress}) {
         SceneDescription scene = sample_scene();
         scene.garments.at(0).type = type;
         auto world = build_world(scene, {});
         ASSERT_TRUE(world) << world.error().message;
         const Garment& g = world->registry.get<Garment>(world->garments.at(0));
-        Real worst = 0;
+        double farthest = 0, deepest = 0;
         for (int frame = 0; frame < 90; ++frame) {
             ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
-            worst = std::max(worst, measure_garment(world->registry, g).pins_inside_m);
+            const SkinDepths d = skin_depths(world->registry, g);
+            ASSERT_TRUE(d.measured);
+            ASSERT_FALSE(d.pins_m.empty());
+            for (const double distance : d.pins_m) {
+                farthest = std::max(farthest, distance);
+                deepest = std::max(deepest, -distance);
+            }
         }
-        EXPECT_LE(worst, 0.5e-3f) << garment_type_name(type);
+        // Measured: the skirt's pins at most 12.8 mm off the skin (its ease 10 mm), the
+        // dress's 24.1 mm (15 mm, and the ellipsoids' bulge over the skin under the arms);
+        // none behind it. Allowed: the ease and 2 cm of the fit's bulge.
+        EXPECT_LE(deepest, 0.5e-3) << garment_type_name(type) << ": a pin lies behind the skin";
+        const double ease = type == GarmentType::skirt ? TubeParams::skirt().ease_m : TubeParams::dress().ease_m;
+        EXPECT_LE(farthest, ease + 0.02) << garment_type_name(type) << ": a pin stands off the skin";
     }
 }
 

@@ -16,6 +16,7 @@
 #include "drape/game/video.hpp"
 #include "tests/character/test_character_file.hpp"
 #include "tests/test_paths.hpp"
+#include "tests/shared_assets.hpp"
 
 namespace drape {
 namespace {
@@ -79,6 +80,7 @@ TEST_F(PlayCommand, BadValuesGiveOneLineNamingTheOption) {
         {"--headless --time-scale nan", "drape play: --time-scale: must be a number in [0, 1000], got nan\n"},
         {"--headless --out frames", "drape play: --headless: cannot be combined with --out (nothing is rendered)\n"},
         {"--headless --window", "drape play: --headless: cannot be combined with --window (nothing is rendered)\n"},
+        {"--headless --hud", "drape play: --hud: nothing is rendered (--headless, or no render module) to draw it on\n"},
         {"--headless --character nothing.glb", "drape play: --character: no such file: nothing.glb\n"},
         {"--headless --stats no/such/folder/stats.json", "drape play: --stats: folder no/such/folder does not exist\n"},
         {"--headless --scene nothing.json", "drape play: nothing.json: no such scene file\n"},
@@ -103,7 +105,7 @@ TEST_F(PlayCommand, CommandLineErrorsAreOneLineWithTheSameExitCodeAsOtherBadInpu
         {"play --frames", "drape play: --frames: needs a value\n"},
         {"play --scene ''", "drape play: --scene: must not be empty\n"},
         {"play --frames 3 --frames 4", "drape play: --frames: given 2 times; give it once\n"},
-        {"play --garment hat", "drape play: --garment: must be one of skirt, dress, none, got \"hat\"\n"},
+        {"play --garment hat", "drape play: --garment: must be skirt, dress, none or a garment file (FILE[:MESH]); no such file: hat\n"},
         {"play --model fancy", "drape play: --model: must be one of simplified, classic, got \"fancy\"\n"},
         {"play --fps 0", "drape play: --fps: must be a number in [1, 1000], got 0\n"},
         {"play --fps 1e9", "drape play: --fps: must be a number in [1, 1000], got 1e9\n"},
@@ -113,7 +115,7 @@ TEST_F(PlayCommand, CommandLineErrorsAreOneLineWithTheSameExitCodeAsOtherBadInpu
         {"play --colour red", "drape play: --colour: unknown option (--help lists the options)\n"},
         {"play scene.json", "drape play: scene.json: unexpected argument (--help lists the options)\n"},
         {"dance", "drape: dance: no such command (commands: play, inspect, make-avatar"},  // + bench when built
-        {"inspect", "drape inspect: file: missing (a required argument; --help shows the usage)\n"},
+        {"inspect", "drape inspect: give a character file (or --garment FILE)\n"},
         {"inspect missing.glb", "drape inspect: missing.glb: no such file\n"},
     };
     for (const Case& c : cases) {
@@ -275,6 +277,105 @@ TEST_F(PlayCommand, HeadlessRunWritesStatsAndTrace) {
     EXPECT_FALSE(stats["systems"].contains("render"));
     EXPECT_TRUE(fs::exists(m_dir / "trace.json"));
     EXPECT_FALSE(fs::exists(m_dir / "out")) << "headless must not write frames";
+}
+
+TEST_F(PlayCommand, VersionIsTheProjectVersion) {
+    const PlayRun run = drape("--version", m_dir);
+    EXPECT_EQ(run.status, 0);
+    EXPECT_EQ(run.output, std::string("drape ") + test::version() + "\n");
+}
+
+TEST_F(PlayCommand, EveryRunEndsWithAVerdictOnEachGarment) {
+    const PlayRun run = play("--headless --frames 30", m_dir);
+    ASSERT_EQ(run.status, 0) << run.output;
+    const auto at = run.output.find("\nskirt: strain p99 ");
+    ASSERT_NE(at, std::string::npos) << run.output;
+    const std::string line = run.output.substr(at + 1, run.output.find('\n', at + 1) - at - 1);
+    EXPECT_NE(line.find(", max "), std::string::npos) << line;
+    EXPECT_NE(line.find(" mm: within the contract"), std::string::npos) << line;
+}
+
+TEST_F(PlayCommand, AGarmentOutsideTheContractIsAWarningAndAFailureOnlyWithStrict) {
+    // No strain limit to speak of and a stretch modulus a thousand times too weak: the
+    // skirt sags far past 20 %.
+    std::ofstream(m_dir / "weak.json") << R"({"characters": [{"file": ")" << test::source_dir().string() << R"(/assets/avatar.glb"}],
+        "garments": [{"type": "skirt", "stretch_N_m": 2, "strain_limit": 10}]})";
+    const PlayRun run = play("--scene weak.json --headless --frames 30", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_NE(run.output.find("drape play: warning: skirt: strain p99 "), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find(": outside the contract: "), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("strain max "), std::string::npos) << run.output;
+
+    const PlayRun strict = play("--scene weak.json --headless --frames 30 --strict", m_dir);
+    EXPECT_EQ(strict.status, 1) << strict.output;
+    EXPECT_NE(strict.output.find("drape play: 1 garment(s) outside the contract (--strict)\n"), std::string::npos) << strict.output;
+
+    const PlayRun kept = play("--headless --frames 30 --strict", m_dir);
+    EXPECT_EQ(kept.status, 0) << kept.output;
+}
+
+TEST_F(PlayCommand, ATraceSaysHowManyEventsItDroppedAndItsSizeCanBeSet) {
+    const PlayRun small = play("--headless --frames 5 --trace small.json --trace-size 16", m_dir);
+    ASSERT_EQ(small.status, 0) << small.output;
+    EXPECT_NE(small.output.find("trace: small.json, 16 events\n"), std::string::npos) << small.output;
+    EXPECT_NE(small.output.find("drape play: warning: --trace: "), std::string::npos) << small.output;
+    EXPECT_NE(small.output.find(" events were dropped: the trace keeps the last 16 (--trace-size N keeps more)"), std::string::npos)
+        << small.output;
+    std::ifstream in(m_dir / "small.json");
+    const nlohmann::json trace = nlohmann::json::parse(in);
+    EXPECT_EQ(trace["otherData"]["kept_events"], 16);
+    EXPECT_GT(trace["otherData"]["dropped_events"].get<int>(), 0);
+
+    const PlayRun full = play("--headless --frames 5 --trace full.json", m_dir);
+    ASSERT_EQ(full.status, 0) << full.output;
+    EXPECT_EQ(full.output.find("dropped"), std::string::npos) << full.output;
+
+    const PlayRun alone = play("--headless --frames 5 --trace-size 100", m_dir);
+    EXPECT_EQ(alone.status, 1);
+    EXPECT_EQ(alone.output, "drape play: --trace-size: needs --trace FILE (the trace it sizes)\n");
+}
+
+// Garments from files from the command line (docs/garments.md): a built-in skirt written,
+// inspected, played; the cut garments written; nothing overwritten.
+TEST_F(PlayCommand, GarmentFilesAreWrittenInspectedAndPlayed) {
+    PlayRun run = drape("export-garment --out skirt.gltf", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_TRUE(fs::exists(m_dir / "skirt.gltf") && fs::exists(m_dir / "skirt.bin"));
+    run = drape("export-garment --out skirt.gltf", m_dir);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_EQ(run.output, "drape export-garment: --out: skirt.gltf: exists (not overwritten)\n");
+    run = drape("inspect --garment skirt.gltf", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_NE(run.output.find("grid: the mesh's own 27 x 31 lattice, closed, 27 particles held (painted)"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("texture: none (drawn in the garment's colour)"), std::string::npos) << run.output;
+    run = play("--headless --frames 30 --garment skirt.gltf", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_NE(run.output.find("skirt: strain p99"), std::string::npos) << run.output;
+    run = play("--headless --frames 30 --garment skirt.gltf:Belt", m_dir);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_NE(run.output.find("skirt.gltf: no mesh named 'Belt' (meshes: Skirt)"), std::string::npos) << run.output;
+    EXPECT_EQ(lines(run.output), 1) << run.output;
+
+    // Another character: its own clips (the sample's clip name, Walk, means nothing to it).
+    const fs::path other = test::shared_assets() / "characters/male_casual/Male_Casual.fbx";
+    if (fs::exists(other)) {
+        run = drape("export-garment --garment dress --character '" + other.string() + "' --out dress.glb", m_dir);
+        EXPECT_EQ(run.status, 0) << run.output;
+        run = drape("make-garments --character '" + other.string() + "' --out cut_other", m_dir);
+        EXPECT_EQ(run.status, 0) << run.output;
+    }
+
+    run = drape("make-garments --out cut", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    for (const char* name : {"flared_skirt", "wrap_skirt", "panel_dress", "cape"}) EXPECT_TRUE(fs::exists(m_dir / "cut" / (std::string(name) + ".glb")));
+    run = drape("inspect --garment cut/flared_skirt.glb", m_dir);
+    EXPECT_EQ(run.status, 0) << run.output;
+    EXPECT_NE(run.output.find("texture: base colour 512x512, by the UVs, repeated"), std::string::npos) << run.output;
+    const auto written = fs::last_write_time(m_dir / "cut" / "cape.glb");
+    run = drape("make-garments --out cut", m_dir);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_NE(run.output.find("exists (not overwritten)"), std::string::npos) << run.output;
+    EXPECT_EQ(fs::last_write_time(m_dir / "cut" / "cape.glb"), written);
 }
 
 TEST_F(PlayCommand, VideoWithoutFfmpegIsAClearError) {

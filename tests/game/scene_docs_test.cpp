@@ -1,12 +1,16 @@
 // docs/scenes.md lists the garment parameters exactly as the parameter table says: the list
 // is generated (`drape scene-parameters`), and this test fails when the copy in the docs
-// differs, with the command that regenerates it.
+// differs, with the command that regenerates it. And every field the scene parser accepts
+// (game/scene_file.cpp) is named in the docs' section of its object: the parser itself says
+// which fields it knows, in the error on an unknown one.
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
+#include "drape/game/scene_file.hpp"
 #include "drape/game/scene_garment_parameters.hpp"
 #include "tests/test_paths.hpp"
 
@@ -30,6 +34,64 @@ TEST(SceneDocs, GarmentParameterListIsTheTable) {
     EXPECT_EQ(listed, garment_parameters_markdown())
         << "docs/scenes.md's garment parameter list differs from the table (systems/cloth/garment_parameters.cpp): "
            "replace it with the output of `build/drape scene-parameters`";
+}
+
+std::string read_docs() {
+    std::ifstream in(test::source_dir().string() + "/docs/scenes.md");
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The docs' section under the heading that starts with `heading`, up to the next "## ".
+std::string section(const std::string& docs, const std::string& heading) {
+    const std::size_t from = docs.find("\n" + heading);
+    if (from == std::string::npos) return {};
+    const std::size_t to = docs.find("\n## ", from + 1);
+    return docs.substr(from, to == std::string::npos ? std::string::npos : to - from);
+}
+
+// The fields the parser knows in the object that holds "not_a_field", from its error
+// ("...: unknown field; known fields: a, b, c").
+std::vector<std::string> known_fields(const std::string& scene) {
+    auto parsed = parse_scene(scene, "docs_test.json", test::source_dir());
+    EXPECT_FALSE(parsed) << scene;
+    if (parsed) return {};
+    const std::string& message = parsed.error().message;
+    EXPECT_NE(message.find("not_a_field: unknown field"), std::string::npos) << message;
+    const std::string marker = "known fields: ";
+    const std::size_t at = message.find(marker);
+    if (at == std::string::npos) return {};
+    std::vector<std::string> names;
+    std::string rest = message.substr(at + marker.size());
+    for (std::size_t comma; (comma = rest.find(", ")) != std::string::npos; rest.erase(0, comma + 2)) names.push_back(rest.substr(0, comma));
+    names.push_back(rest);
+    return names;
+}
+
+TEST(SceneDocs, EveryFieldTheParserAcceptsIsNamedInItsSection) {
+    const std::string docs = read_docs();
+    ASSERT_FALSE(docs.empty()) << "docs/scenes.md is missing";
+    const std::string character = R"({"file": "assets/avatar.glb")";
+    struct Object {
+        std::string heading, scene;
+    };
+    const std::vector<Object> objects = {
+        {"## Top level", R"({"characters": [)" + character + R"(}], "not_a_field": 1})"},
+        {"## `characters[i]`", R"({"characters": [)" + character + R"(, "not_a_field": 1}]})"},
+        {"## `garments[i]`", R"({"characters": [)" + character + R"(}], "garments": [{"not_a_field": 1}]})"},
+        {"## `colliders[i]`", R"({"characters": [)" + character + R"(}], "colliders": [{"bone": "Hips", "remove": true, "not_a_field": 1}]})"},
+        {"## `solver`", R"({"characters": [)" + character + R"(}], "solver": {"not_a_field": 1}})"},
+        {"## `camera`", R"({"characters": [)" + character + R"(}], "camera": {"not_a_field": 1}})"},
+    };
+    for (const Object& o : objects) {
+        SCOPED_TRACE(o.heading);
+        const std::string text = section(docs, o.heading);
+        ASSERT_FALSE(text.empty()) << "docs/scenes.md lacks the section " << o.heading;
+        const std::vector<std::string> fields = known_fields(o.scene);
+        EXPECT_GE(fields.size(), 1u);
+        for (const std::string& field : fields)
+            EXPECT_NE(text.find("`" + field + "`"), std::string::npos)
+                << "docs/scenes.md, " << o.heading << ": the parser accepts `" << field << "` but the section does not name it";
+    }
 }
 
 }  // namespace

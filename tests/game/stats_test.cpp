@@ -42,8 +42,15 @@ RunStats example() {
     r.systems.push_back(s);
     r.characters.push_back({.file = "assets/avatar.glb", .clip = "Walk", .height_m = 1.75});
     r.garments.push_back({.particles = 837, .strain_max = 0.1, .strain_p99 = 0.05, .penetration_after_frame_m = 0.0001,
-                          .within_give_m = 0.02, .penetration_before_response_m = 0.004, .pins_inside_m = 0.002, .rise_above_pins_m = 0.01,
+                          .within_give_m = 0.02, .penetration_before_response_m = 0.004, .pins_inside_m = 0.002, .below_ground_m = 0.003, .rise_above_pins_m = 0.01,
                           .nonfinite = 0, .resets = 1, .collision_tests_per_frame = 1234.5});
+    r.garments.back().compression_min = 0.8;
+    r.garments.back().repair_rounds_max = 7;
+    r.garments.back().budget_hits = 3;
+    r.garments.back().skin_measured = true;
+    r.garments.back().skin_penetration_p99_m = 0.004;
+    r.garments.back().skin_penetration_max_m = 0.006;
+    r.garments.back().skin_penetration_share = 0.01;
     return r;
 }
 
@@ -66,14 +73,23 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     ASSERT_TRUE(j["garments"].is_array());
     ASSERT_EQ(j["garments"].size(), 1u);
     const auto& g = j["garments"][0];
-    EXPECT_EQ(keys(g), (std::vector<std::string>{"collision_tests_per_frame", "max_penetration_m", "max_strain", "nonfinite",
-                                                 "particles", "penetration_m", "pins_inside_m", "resets", "rise_above_pins_m",
-                                                 "strain"}));
+    EXPECT_EQ(keys(g), (std::vector<std::string>{"budget_hits", "collision_tests_per_frame", "compression_min",
+                                                 "max_penetration_m", "max_strain", "nonfinite", "particles", "penetration_m",
+                                                 "pins_inside_m", "repair_rounds_max", "resets", "rise_above_pins_m",
+                                                 "skin_penetration_m", "strain"}));
+    EXPECT_DOUBLE_EQ(g["compression_min"].get<double>(), 0.8);
+    EXPECT_EQ(g["repair_rounds_max"], 7);
+    EXPECT_EQ(g["budget_hits"], 3);
     EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99"}));
-    EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max", "within_give_max"}));
+    EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max", "below_ground_max", "within_give_max"}));
     EXPECT_DOUBLE_EQ(g["strain"]["p99"].get<double>(), 0.05);
     EXPECT_DOUBLE_EQ(g["penetration_m"]["before_response_max"].get<double>(), 0.004);
     EXPECT_DOUBLE_EQ(g["penetration_m"]["within_give_max"].get<double>(), 0.02);
+    EXPECT_DOUBLE_EQ(g["penetration_m"]["below_ground_max"].get<double>(), 0.003);
+    EXPECT_EQ(keys(g["skin_penetration_m"]), (std::vector<std::string>{"max", "p99", "share"}));
+    EXPECT_DOUBLE_EQ(g["skin_penetration_m"]["p99"].get<double>(), 0.004);
+    EXPECT_DOUBLE_EQ(g["skin_penetration_m"]["max"].get<double>(), 0.006);
+    EXPECT_DOUBLE_EQ(g["skin_penetration_m"]["share"].get<double>(), 0.01);
     EXPECT_EQ(g["resets"], 1);
     EXPECT_EQ(g["particles"], 837);
     EXPECT_DOUBLE_EQ(g["collision_tests_per_frame"].get<double>(), 1234.5);

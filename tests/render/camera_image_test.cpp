@@ -5,8 +5,6 @@
 #include <filesystem>
 #include <numbers>
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC
 #include <stb/stb_image.h>
 
 #include "drape/engine/render/camera.hpp"

@@ -6,8 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <set>
 
+#include "drape/components/garment_surface.hpp"
 #include "drape/engine/core/scheduler.hpp"
 #include "drape/engine/render/renderer.hpp"
 #include "drape/engine/render/shaders.hpp"
@@ -178,6 +180,61 @@ TEST(RenderOffscreen, GarmentIsDoubleSidedAndLitFromBehind) {
     const Rgb back = pixel(image, *p);
     EXPECT_GT(back.r, back.g + 40) << back.r << "," << back.g << "," << back.b;
     EXPECT_GT(back.r, 60) << "the back face is shaded with the flipped normal, not black";
+}
+
+// A garment drawn as authored with its base-colour texture: a print in four quadrants (green,
+// blue above; yellow, white below) over the red panel, mapped by its UVs (u to the right, v
+// up), shows each colour where its quadrant lies, and not the garment's own red.
+TEST(RenderOffscreen, AGarmentsTextureIsDrawnWhereItsUvsPutIt) {
+    auto renderer = make_renderer();
+    ASSERT_TRUE(renderer);
+    Scene scene;
+    const Garment& garment = scene.registry.get<Garment>(scene.garment);
+    const Matrix3X& x = garment.state.x;
+    const Vec3 low = x.rowwise().minCoeff(), high = x.rowwise().maxCoeff();
+    GarmentSurface surface;
+    surface.triangles = garment.fabric->triangles;
+    surface.carriers.assign(static_cast<std::size_t>(x.cols()), {0, 0, 0});
+    surface.positions = x;
+    surface.normals = Matrix3X::Zero(3, x.cols());
+    surface.normals.row(2).setOnes();
+    surface.uvs.resize(2, x.cols());
+    for (Eigen::Index i = 0; i < x.cols(); ++i)
+        surface.uvs.col(i) = Eigen::Vector2f((x(0, i) - low.x()) / (high.x() - low.x()), (x(1, i) - low.y()) / (high.y() - low.y()));
+    auto print = std::make_shared<Image>();
+    print->width = print->height = 8;
+    for (int py = 0; py < 8; ++py)
+        for (int px = 0; px < 8; ++px) {
+            const std::uint8_t c[4][3] = {{30, 200, 40}, {30, 40, 220}, {230, 210, 20}, {250, 250, 250}};
+            const auto& q = c[(py >= 4 ? 2 : 0) + (px >= 4 ? 1 : 0)];
+            print->rgba.insert(print->rgba.end(), {q[0], q[1], q[2], 255});
+        }
+    surface.base_color = print;
+    scene.registry.emplace<GarmentSurface>(scene.garment, surface);
+    renderer->camera().target = scene.panel_centre();
+    const Image image = render(*renderer, scene.registry);
+    save(image, "garment-textured");
+    const auto at = [&](Real u, Real v) {
+        const Vec3 p(low.x() + u * (high.x() - low.x()), low.y() + v * (high.y() - low.y()), low.z());
+        const auto screen = renderer->camera().project(p, width, height);
+        EXPECT_TRUE(screen);
+        return screen ? pixel(image, *screen) : Rgb{0, 0, 0};
+    };
+    const Rgb green = at(0.25f, 0.75f), blue = at(0.75f, 0.75f), yellow = at(0.25f, 0.25f), white = at(0.75f, 0.25f);
+    EXPECT_GT(green.g, green.r + 40) << green.r << "," << green.g << "," << green.b;
+    EXPECT_GT(green.g, green.b + 40) << green.r << "," << green.g << "," << green.b;
+    EXPECT_GT(blue.b, blue.r + 40) << blue.r << "," << blue.g << "," << blue.b;
+    EXPECT_GT(blue.b, blue.g + 40) << blue.r << "," << blue.g << "," << blue.b;
+    EXPECT_GT(std::min(yellow.r, yellow.g), yellow.b + 40) << yellow.r << "," << yellow.g << "," << yellow.b;
+    EXPECT_LT(std::max({white.r, white.g, white.b}) - std::min({white.r, white.g, white.b}), 40) << white.r << "," << white.g << "," << white.b;
+    EXPECT_GT(luminance(white), luminance(blue) + 40);
+    // Without the texture: the garment's red again.
+    scene.registry.get<GarmentSurface>(scene.garment).base_color.reset();
+    const Image plain = render(*renderer, scene.registry);
+    const auto p = renderer->camera().project(Vec3(low.x() + 0.25f * (high.x() - low.x()), low.y() + 0.75f * (high.y() - low.y()), low.z()), width, height);
+    ASSERT_TRUE(p);
+    const Rgb red = pixel(plain, *p);
+    EXPECT_GT(red.r, red.g + 40) << red.r << "," << red.g << "," << red.b;
 }
 
 TEST(RenderOffscreen, GarmentNormalsFollowItsParticles) {

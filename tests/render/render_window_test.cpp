@@ -185,7 +185,7 @@ TEST(RenderWindow, OneFrameRendersInAnXvfbWindowAndReadsBack) {
     const int screen_r = int((on_screen >> 16) & 0xff), screen_g = int((on_screen >> 8) & 0xff);
     XDestroyImage(shown);
     EXPECT_GT(screen_g, screen_r + 60) << "the window shows the frame: " << screen_r << "," << screen_g;
-    for (KeySym key : {XK_space, XK_n, XK_e, XK_m, XK_r, XK_Escape}) {
+    for (KeySym key : {XK_space, XK_n, XK_e, XK_m, XK_r, XK_h, XK_Escape}) {
         XEvent event{};
         event.type = KeyPress;
         event.xkey.keycode = XKeysymToKeycode(x, key);
@@ -210,7 +210,7 @@ TEST(RenderWindow, OneFrameRendersInAnXvfbWindowAndReadsBack) {
     XCloseDisplay(x);
 
     const Real yaw_before = camera.yaw_rad;
-    for (int tries = 0; tries < 100 && input.actions.size() < 6; ++tries) {
+    for (int tries = 0; tries < 100 && input.actions.size() < 7; ++tries) {
         InputState more;
         renderer.poll_events(more);
         input.actions.insert(input.actions.end(), more.actions.begin(), more.actions.end());
@@ -218,10 +218,17 @@ TEST(RenderWindow, OneFrameRendersInAnXvfbWindowAndReadsBack) {
         ::usleep(10000);
     }
     const std::vector<Action> expected{Action::toggle_pause, Action::step,  Action::toggle_ellipsoids,
-                                       Action::switch_model, Action::reset, Action::quit};
+                                       Action::switch_model, Action::reset, Action::toggle_hud, Action::quit};
     EXPECT_EQ(input.actions, expected);
     EXPECT_FLOAT_EQ(input.orbit_dx_px, 40.0f);
     EXPECT_NE(camera.yaw_rad, yaw_before) << "a drag orbits the camera";
+
+    // The title follows set_window_title (drape play shows the fps and ms there).
+    renderer.set_window_title("Drape  60 fps  16.7 ms");
+    Display* y = XOpenDisplay(server.display().c_str());
+    ASSERT_NE(y, nullptr);
+    EXPECT_NE(find_window(y, DefaultRootWindow(y), "Drape  60 fps  16.7 ms"), 0u) << "the new title is not shown";
+    XCloseDisplay(y);
 #endif
 }
 

@@ -123,7 +123,7 @@ TEST(SampleSceneRender, MeshIsSkinnedOncePerDrawnFrameNotPerStep) {
         EXPECT_EQ(report->steps, 2);
     }
     EXPECT_EQ(skin.skinned_vertices - at_start, frames * vertices);
-    EXPECT_EQ(world->scheduler.system_names(Phase::render), (std::vector<std::string>{"skinning", "skin_cover", "render"}));
+    EXPECT_EQ(world->scheduler.system_names(Phase::render), (std::vector<std::string>{"skinning", "skin_cover", "garment_surface", "render"}));
     // The drawn body is the current pose: the skinning matrices applied now, and the skirt's
     // cover (systems/skin_cover_system.hpp), give the same vertices.
     const Matrix3X drawn = skin.positions;

@@ -1,0 +1,561 @@
+#include "drape/systems/cloth/garment_from_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <sstream>
+
+#include "drape/components/garment_surface.hpp"
+#include "drape/components/body_landmarks.hpp"
+#include "drape/components/skeleton.hpp"
+#include "drape/components/skinned_mesh.hpp"
+#include "drape/engine/assets/skinning.hpp"
+#include "drape/systems/character/skin_surface.hpp"
+#include "drape/systems/cloth/garment_surface.hpp"
+#include "drape/components/transform.hpp"
+
+namespace drape {
+namespace {
+
+// The default distance between warp lines and between weft rows of a resampled grid: the
+// built-in skirt's line spacing (TubeParams::line_spacing_m).
+constexpr Real default_spacing_m = Real(0.029);
+
+std::string number(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+// Sorted distinct values of `values`, those within `tolerance` of the previous one merged.
+std::vector<Real> distinct(std::vector<Real> values, Real tolerance) {
+    std::sort(values.begin(), values.end());
+    std::vector<Real> out;
+    for (Real v : values)
+        if (out.empty() || v - out.back() > tolerance) out.push_back(v);
+    return out;
+}
+
+// One panel of the pattern: a connected piece of the mesh, its triangles, its UV box and
+// its scale on the surface (metres per unit of u and of v).
+struct Panel {
+    std::vector<std::size_t> triangles;  // first indices into GarmentMeshAsset::indices
+    Real u0 = 0, u1 = 0, v0 = 0, v1 = 0;
+    double per_u = 0, per_v = 0;
+};
+
+// The mesh's panels (connected pieces through shared vertices), in the order of their
+// first triangles.
+std::vector<Panel> find_panels(const GarmentMeshAsset& mesh) {
+    std::vector<std::uint32_t> parent(mesh.vertex_count());
+    std::iota(parent.begin(), parent.end(), 0u);
+    const auto root = [&](std::uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        parent[root(mesh.indices[t + 1])] = root(mesh.indices[t]);
+        parent[root(mesh.indices[t + 2])] = root(mesh.indices[t]);
+    }
+    std::vector<Panel> panels;
+    std::vector<std::int64_t> panel_of(mesh.vertex_count(), -1);
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        std::int64_t& k = panel_of[root(mesh.indices[t])];
+        if (k < 0) k = static_cast<std::int64_t>(panels.size()), panels.emplace_back();
+        panels[static_cast<std::size_t>(k)].triangles.push_back(t);
+    }
+    for (Panel& panel : panels) {
+        panel.u0 = panel.v0 = std::numeric_limits<Real>::infinity();
+        panel.u1 = panel.v1 = -std::numeric_limits<Real>::infinity();
+        double weight = 0;
+        for (const std::size_t t : panel.triangles) {
+            const auto i = [&](std::size_t k) { return mesh.indices[t + k]; };
+            for (std::size_t k = 0; k < 3; ++k) {
+                panel.u0 = std::min(panel.u0, mesh.uvs(0, i(k))), panel.u1 = std::max(panel.u1, mesh.uvs(0, i(k)));
+                panel.v0 = std::min(panel.v0, mesh.uvs(1, i(k))), panel.v1 = std::max(panel.v1, mesh.uvs(1, i(k)));
+            }
+            Eigen::Matrix2d d;
+            d.col(0) = (mesh.uvs.col(i(1)) - mesh.uvs.col(i(0))).cast<double>();
+            d.col(1) = (mesh.uvs.col(i(2)) - mesh.uvs.col(i(0))).cast<double>();
+            const double det = d.determinant();
+            if (std::abs(det) < 1e-14) continue;
+            Eigen::Matrix<double, 3, 2> e;
+            e.col(0) = (mesh.positions.col(i(1)) - mesh.positions.col(i(0))).cast<double>();
+            e.col(1) = (mesh.positions.col(i(2)) - mesh.positions.col(i(0))).cast<double>();
+            const Eigen::Matrix<double, 3, 2> j = e * d.inverse();
+            panel.per_u += j.col(0).norm() * std::abs(det);
+            panel.per_v += j.col(1).norm() * std::abs(det);
+            weight += std::abs(det);
+        }
+        if (weight > 0) panel.per_u /= weight, panel.per_v /= weight;
+    }
+    return panels;
+}
+
+// Where a UV point lies on the mesh: its triangle and barycentric weights.
+struct SurfacePoint {
+    std::size_t triangle = 0;  // first index into indices
+    Real w0 = 0, w1 = 0, w2 = 0;
+};
+
+// Finds UV points' triangles in one panel through a bucket grid over its box.
+class UvLocator {
+public:
+    UvLocator(const GarmentMeshAsset& mesh, const Panel& panel) : m_mesh(mesh), m_u0(panel.u0), m_v0(panel.v0) {
+        m_cells = std::clamp<int>(static_cast<int>(std::sqrt(Real(panel.triangles.size()))), 1, 256);
+        m_du = std::max(panel.u1 - panel.u0, Real(1e-12)) / Real(m_cells);
+        m_dv = std::max(panel.v1 - panel.v0, Real(1e-12)) / Real(m_cells);
+        m_buckets.resize(static_cast<std::size_t>(m_cells * m_cells));
+        for (const std::size_t t : panel.triangles) {
+            Real lo_u = std::numeric_limits<Real>::infinity(), hi_u = -lo_u, lo_v = lo_u, hi_v = -lo_u;
+            for (std::size_t k = 0; k < 3; ++k) {
+                const auto uv = mesh.uvs.col(mesh.indices[t + k]);
+                lo_u = std::min(lo_u, uv.x()), hi_u = std::max(hi_u, uv.x());
+                lo_v = std::min(lo_v, uv.y()), hi_v = std::max(hi_v, uv.y());
+            }
+            for (int i = cell_u(lo_u); i <= cell_u(hi_u); ++i)
+                for (int j = cell_v(lo_v); j <= cell_v(hi_v); ++j) m_buckets[static_cast<std::size_t>(j * m_cells + i)].push_back(t);
+        }
+    }
+
+    // The triangle holding (u, v), or the one it lies least outside of when that is within
+    // `slack` in barycentric terms (a point on the panel's edge); none otherwise.
+    [[nodiscard]] std::optional<SurfacePoint> locate(Real u, Real v, Real slack = Real(1e-4)) const {
+        std::optional<SurfacePoint> best;
+        double best_min = -std::numeric_limits<double>::infinity();
+        for (const std::size_t t : m_buckets[static_cast<std::size_t>(cell_v(v) * m_cells + cell_u(u))]) {
+            const Eigen::Vector2d a = m_mesh.uvs.col(m_mesh.indices[t]).cast<double>();
+            const Eigen::Vector2d b = m_mesh.uvs.col(m_mesh.indices[t + 1]).cast<double>();
+            const Eigen::Vector2d c = m_mesh.uvs.col(m_mesh.indices[t + 2]).cast<double>();
+            const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+            if (std::abs(det) < 1e-18) continue;
+            const Eigen::Vector2d q = Eigen::Vector2d(u, v) - a;
+            const double w1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
+            const double w2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
+            const double w0 = 1 - w1 - w2;
+            const double lowest = std::min({w0, w1, w2});
+            if (lowest > best_min) {
+                best_min = lowest;
+                best = SurfacePoint{t, static_cast<Real>(w0), static_cast<Real>(w1), static_cast<Real>(w2)};
+            }
+        }
+        if (!best || best_min < -slack) return std::nullopt;
+        return best;
+    }
+
+    [[nodiscard]] Vec3 position(const SurfacePoint& s) const {
+        const auto& x = m_mesh.positions;
+        const auto& i = m_mesh.indices;
+        return s.w0 * x.col(i[s.triangle]) + s.w1 * x.col(i[s.triangle + 1]) + s.w2 * x.col(i[s.triangle + 2]);
+    }
+    [[nodiscard]] Real pin(const SurfacePoint& s) const {
+        const auto& i = m_mesh.indices;
+        return s.w0 * m_mesh.pin[i[s.triangle]] + s.w1 * m_mesh.pin[i[s.triangle + 1]] + s.w2 * m_mesh.pin[i[s.triangle + 2]];
+    }
+
+private:
+    [[nodiscard]] int cell_u(Real u) const { return std::clamp(static_cast<int>((u - m_u0) / m_du), 0, m_cells - 1); }
+    [[nodiscard]] int cell_v(Real v) const { return std::clamp(static_cast<int>((v - m_v0) / m_dv), 0, m_cells - 1); }
+
+    const GarmentMeshAsset& m_mesh;
+    Real m_u0, m_v0, m_du = 1, m_dv = 1;
+    int m_cells = 1;
+    std::vector<std::vector<std::size_t>> m_buckets;
+};
+
+// Where the panel crosses the level v: the least and the greatest u of its triangles'
+// edges there (a panel is one piece across at every level).
+std::pair<Real, Real> row_span(const GarmentMeshAsset& mesh, const Panel& panel, Real v) {
+    Real lo = std::numeric_limits<Real>::infinity(), hi = -lo;
+    for (const std::size_t t : panel.triangles)
+        for (std::size_t k = 0; k < 3; ++k) {
+            const auto a = mesh.uvs.col(mesh.indices[t + k]), b = mesh.uvs.col(mesh.indices[t + (k + 1) % 3]);
+            if ((a.y() - v) * (b.y() - v) > 0) continue;
+            Real u = a.x();
+            if (a.y() != b.y()) u = a.x() + (b.x() - a.x()) * (v - a.y()) / (b.y() - a.y());
+            else lo = std::min(lo, b.x()), hi = std::max(hi, b.x());
+            lo = std::min(lo, u), hi = std::max(hi, u);
+        }
+    return {lo, hi};
+}
+
+// One panel's grid: `lines` lines (its two side edges included) of `rows` rows, in grid
+// order (line * rows + row), with the pin paint read at each point.
+struct PanelGrid {
+    int lines = 0;
+    Matrix3X x;
+    VectorX pin;
+    int outside = 0;  // points that fell outside the panel
+};
+
+PanelGrid grid_panel(const GarmentMeshAsset& mesh, const Panel& panel, int segments, int rows, bool painted) {
+    const UvLocator locator(mesh, panel);
+    PanelGrid g;
+    g.lines = segments + 1;
+    g.x.resize(3, g.lines * rows);
+    g.pin = VectorX::Zero(g.lines * rows);
+    for (int row = 0; row < rows; ++row) {
+        // Rows a hair inside the panel's ends, whose level may touch it at one point only.
+        const Real t = std::clamp(Real(row) / Real(rows - 1), Real(1e-5), Real(1) - Real(1e-5));
+        const Real v = panel.v0 + (panel.v1 - panel.v0) * t;
+        const auto [lo, hi] = row_span(mesh, panel, v);
+        for (int line = 0; line < g.lines; ++line) {
+            const Real u = lo + (hi - lo) * Real(line) / Real(segments);
+            const auto at = locator.locate(u, v);
+            if (!at) {
+                ++g.outside;
+                g.x.col(line * rows + row).setZero();
+                continue;
+            }
+            g.x.col(line * rows + row) = locator.position(*at);
+            if (painted) g.pin[line * rows + row] = locator.pin(*at);
+        }
+    }
+    return g;
+}
+
+// The mean distance between two lines of points (rows each).
+Real line_gap(const Matrix3X& a, int line_a, const Matrix3X& b, int line_b, int rows) {
+    return (a.middleCols(line_a * rows, rows) - b.middleCols(line_b * rows, rows)).colwise().norm().mean();
+}
+
+}  // namespace
+
+Result<MeshGrid> grid_from_mesh(const GarmentMeshAsset& mesh, const MeshGarmentParams& params, std::string_view name) {
+    const std::string p(name);
+    const std::string what = mesh.name.empty() ? "the mesh" : "mesh '" + mesh.name + "'";
+    if (!(params.spacing_m >= 0 && params.spacing_m <= 1)) return fail(p + ".spacing_m: must be in [0, 1] m, got " + number(params.spacing_m));
+    if (params.weft_stride < 1 || params.weft_stride > 16) return fail(p + ".weft_stride: must be in [1, 16], got " + std::to_string(params.weft_stride));
+    if (params.fitting_rows < 1 || params.fitting_rows > 16) return fail(p + ".fitting_rows: must be in [1, 16], got " + std::to_string(params.fitting_rows));
+    if (mesh.indices.empty() || mesh.indices.size() % 3 != 0) return fail(p + ": " + what + " has no triangles");
+    if (mesh.uvs.cols() != mesh.positions.cols())
+        return fail(p + ": " + what + " has no UV coordinates: the simplified model takes its warp and weft from the pattern "
+                                      "(a garment without UVs is not supported yet)");
+    const bool painted = params.pins == PinSource::painted || (params.pins == PinSource::file && mesh.pin.size() == mesh.positions.cols());
+    if (painted && mesh.pin.size() != mesh.positions.cols())
+        return fail(p + ".pins: " + what + " paints no pins (no COLOR_0): paint the held vertices red or use \"auto\"");
+
+    std::vector<Panel> panels = find_panels(mesh);
+    for (std::size_t k = 0; k < panels.size(); ++k)
+        if (!(panels[k].u1 - panels[k].u0 > Real(1e-6) && panels[k].v1 - panels[k].v0 > Real(1e-6) && panels[k].per_u > 0))
+            return fail(p + ": " + what + "'s panel " + std::to_string(k) + " spans no area in UV");
+    const int stride = params.weft_stride;
+    const Real spacing = params.spacing_m > 0 ? params.spacing_m : default_spacing_m;
+
+    // The mesh's own lattice (one panel whose vertices are a u x v lattice, the files
+    // garment_as_mesh writes): each grid point a vertex, taken as it is.
+    std::vector<std::uint8_t> used(mesh.vertex_count(), 0);
+    for (std::uint32_t v : mesh.indices) used[v] = 1;
+    Matrix3X x;
+    VectorX pin;
+    int n = 0, m = 0;
+    bool closed = false;
+    std::string how;
+    if (params.spacing_m == 0 && panels.size() == 1) {
+        const Panel& panel = panels.front();
+        std::vector<Real> us, vs;
+        for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v)
+            if (used[v]) us.push_back(mesh.uvs(0, v)), vs.push_back(mesh.uvs(1, v));
+        const std::vector<Real> lu = distinct(us, Real(1e-5) * (panel.u1 - panel.u0)), lv = distinct(vs, Real(1e-5) * (panel.v1 - panel.v0));
+        std::vector<std::uint32_t> lattice(lu.size() * lv.size(), std::numeric_limits<std::uint32_t>::max());
+        const auto index_of = [](const std::vector<Real>& values, Real x) {
+            const auto it = std::lower_bound(values.begin(), values.end(), x);
+            if (it == values.end()) return values.size() - 1;
+            if (it != values.begin() && x - *std::prev(it) < *it - x) return static_cast<std::size_t>(std::prev(it) - values.begin());
+            return static_cast<std::size_t>(it - values.begin());
+        };
+        bool complete = std::count(used.begin(), used.end(), 1) == static_cast<std::ptrdiff_t>(lattice.size()) && lv.size() >= 2 && lu.size() >= 2;
+        for (std::uint32_t v = 0; v < mesh.vertex_count() && complete; ++v)
+            if (used[v]) {
+                std::uint32_t& slot = lattice[index_of(lu, mesh.uvs(0, v)) * lv.size() + index_of(lv, mesh.uvs(1, v))];
+                complete = slot == std::numeric_limits<std::uint32_t>::max();
+                slot = v;
+            }
+        if (complete) {
+            m = static_cast<int>(lv.size());
+            const int columns = static_cast<int>(lu.size());
+            closed = line_gap(mesh.positions(Eigen::all, std::vector<std::uint32_t>(lattice.begin(), lattice.begin() + m)), 0,
+                              mesh.positions(Eigen::all, std::vector<std::uint32_t>(lattice.end() - m, lattice.end())), 0, m) <=
+                     Real(1e-4) * std::max<Real>(Real(panel.u1 - panel.u0) * Real(panel.per_u), Real(1));
+            n = closed ? columns - 1 : columns;
+            if (closed ? n % stride == 0 : (n - 1) % stride == 0) {
+                x.resize(3, n * m);
+                pin = VectorX::Zero(n * m);
+                for (int k = 0; k < n * m; ++k) {
+                    x.col(k) = mesh.positions.col(lattice[static_cast<std::size_t>(k)]);
+                    if (painted) pin[k] = mesh.pin[lattice[static_cast<std::size_t>(k)]];
+                }
+                how = "the mesh's own " + std::to_string(n) + " x " + std::to_string(m) + " lattice";
+            }
+        }
+    }
+
+    // Otherwise resampled: each panel's rows at the same shares of its length, its lines
+    // spread across each row (a flared panel's lines fan out as the built-in cone's do), a
+    // multiple of weft_stride segments each, so that a seam falls on a layer-1 line; the
+    // panels then joined side by side where a side edge of one meets a side edge of the next.
+    if (how.empty()) {
+        double longest = 0;
+        for (const Panel& panel : panels) longest = std::max(longest, (panel.v1 - panel.v0) * panel.per_v);
+        m = std::max(2, static_cast<int>(std::lround(longest / spacing)) + 1);
+        std::vector<PanelGrid> grids;
+        for (const Panel& panel : panels) {
+            double width = 0;
+            for (int k = 0; k < 5; ++k) {
+                const auto [lo, hi] = row_span(mesh, panel, panel.v0 + (panel.v1 - panel.v0) * (Real(0.1) + Real(0.2) * Real(k)));
+                width += (hi - lo) * panel.per_u / 5;
+            }
+            const int segments = std::max(stride, static_cast<int>(std::ceil(width / spacing / stride - 0.25)) * stride);
+            if (static_cast<long long>(segments + 1) * m > max_garment_particles)
+                return fail(p + ".spacing_m: " + number(spacing) + " m gives more than " + std::to_string(max_garment_particles) + " particles");
+            grids.push_back(grid_panel(mesh, panel, segments, m, painted));
+            if (grids.back().outside > 0)
+                return fail(p + ": " + std::to_string(grids.back().outside) + " grid points of " + what + "'s panel " +
+                            std::to_string(grids.size() - 1) + " fall outside it: a panel must be one piece across at every level of v "
+                            "(straps, holes and slits are not supported yet)");
+        }
+        // Chain the panels: the next one's first (or, turned, its last) line meets this one's
+        // last; then, for an open garment whose first panel is not at an end, the ones before
+        // it, each whose last (or, turned, first) line meets the chain's first.
+        const Real seam_tolerance = Real(0.25) * spacing;
+        std::vector<int> chain = {0};
+        std::vector<std::uint8_t> placed(grids.size(), 0);
+        placed[0] = 1;
+        const auto turn = [&](PanelGrid& g) {
+            for (int line = 0; line < g.lines / 2; ++line) {
+                g.x.middleCols(line * m, m).swap(g.x.middleCols((g.lines - 1 - line) * m, m));
+                g.pin.segment(line * m, m).swap(g.pin.segment((g.lines - 1 - line) * m, m));
+            }
+        };
+        for (bool grew = true; grew;) {
+            grew = false;
+            const PanelGrid& last = grids[static_cast<std::size_t>(chain.back())];
+            for (std::size_t k = 0; k < grids.size() && !grew; ++k) {
+                if (placed[k]) continue;
+                if (line_gap(grids[k].x, grids[k].lines - 1, last.x, last.lines - 1, m) < seam_tolerance) turn(grids[k]);
+                if (line_gap(grids[k].x, 0, last.x, last.lines - 1, m) < seam_tolerance) {
+                    chain.push_back(static_cast<int>(k));
+                    placed[k] = 1;
+                    grew = true;
+                }
+            }
+        }
+        for (bool grew = true; grew;) {
+            grew = false;
+            const PanelGrid& first = grids[static_cast<std::size_t>(chain.front())];
+            for (std::size_t k = 0; k < grids.size() && !grew; ++k) {
+                if (placed[k]) continue;
+                if (line_gap(grids[k].x, 0, first.x, 0, m) < seam_tolerance) turn(grids[k]);
+                if (line_gap(grids[k].x, grids[k].lines - 1, first.x, 0, m) < seam_tolerance) {
+                    chain.insert(chain.begin(), static_cast<int>(k));
+                    placed[k] = 1;
+                    grew = true;
+                }
+            }
+        }
+        if (chain.size() != grids.size())
+            return fail(p + ": " + what + " has " + std::to_string(grids.size()) + " panels, but only " + std::to_string(chain.size()) +
+                        " join side by side (a panel's side edge must meet the next one's, row for row)");
+        const PanelGrid& first = grids[static_cast<std::size_t>(chain.front())];
+        const PanelGrid& last = grids[static_cast<std::size_t>(chain.back())];
+        closed = line_gap(first.x, 0, last.x, last.lines - 1, m) < seam_tolerance;
+        n = 0;
+        for (int k : chain) n += grids[static_cast<std::size_t>(k)].lines - 1;
+        if (!closed) ++n;
+        x.resize(3, n * m);
+        pin = VectorX::Zero(n * m);
+        int line = 0;
+        for (std::size_t c = 0; c < chain.size(); ++c) {
+            const PanelGrid& g = grids[static_cast<std::size_t>(chain[c])];
+            const int take = c + 1 == chain.size() && !closed ? g.lines : g.lines - 1;  // a seam's line once
+            x.middleCols(line * m, take * m) = g.x.leftCols(take * m);
+            pin.segment(line * m, take * m) = g.pin.head(take * m);
+            line += take;
+        }
+        const std::size_t seams = closed ? panels.size() : panels.size() - 1;
+        how = "resampled " + std::to_string(n) + " x " + std::to_string(m) + " at " + number(spacing) + " m from " +
+              std::to_string(panels.size()) + (panels.size() == 1 ? " panel" : " panels") + " sewn at " + std::to_string(seams) +
+              (seams == 1 ? " seam" : " seams");
+    }
+    if (n < (closed ? 2 * stride : stride + 1))
+        return fail(p + ": " + what + " is too narrow for its weft_stride " + std::to_string(stride) + " (" + std::to_string(n) + " lines)");
+
+    // Row 0 at the held edge: the painted one, else the higher.
+    Real first = 0, last = 0;
+    for (int line = 0; line < n; ++line) {
+        first += painted ? pin[line * m] : x(1, line * m);
+        last += painted ? pin[line * m + m - 1] : x(1, line * m + m - 1);
+    }
+    if (last > first)
+        for (int line = 0; line < n; ++line)
+            for (int row = 0; row < m / 2; ++row) {
+                x.col(line * m + row).swap(x.col(line * m + m - 1 - row));
+                std::swap(pin[line * m + row], pin[line * m + m - 1 - row]);
+            }
+    // Lines in the builders' turn: the line step crossed with the row step points into the
+    // body (components/garment.hpp; the render triangles then face out).
+    const Vec3 centre = x.rowwise().mean();
+    Real inward = 0;
+    for (int line = 0; line + 1 < n; ++line)
+        for (int row = 0; row + 1 < m; ++row) {
+            const Vec3 a = x.col(line * m + row);
+            const Vec3 across = x.col((line + 1) * m + row) - a, down = x.col(line * m + row + 1) - a;
+            Vec3 out = a - centre;
+            out.y() = 0;
+            inward -= across.cross(down).dot(out);
+        }
+    if (inward < 0) {
+        Matrix3X flipped(3, n * m);
+        VectorX flipped_pin(n * m);
+        for (int line = 0; line < n; ++line) {
+            // A tube keeps its first line; a sheet turns end for end.
+            const int from = closed ? (n - line) % n : n - 1 - line;
+            flipped.middleCols(line * m, m) = x.middleCols(from * m, m);
+            flipped_pin.segment(line * m, m) = pin.segment(from * m, m);
+        }
+        x = std::move(flipped);
+        pin = std::move(flipped_pin);
+    }
+
+    MeshGrid out;
+    GridGarment& g = out.grid;
+    g.warp_lines = n;
+    g.particles_per_line = m;
+    g.weft_stride = stride;
+    g.closed = closed;
+    g.grid_positions = std::move(x);
+    g.pinned.assign(static_cast<std::size_t>(n * m), 0);
+    g.config = params.config;
+    int held = 0;
+    for (int k = 0; k < n * m; ++k) {
+        const bool hold = painted ? pin[k] >= Real(0.5) : (k % m) < params.fitting_rows;
+        g.pinned[static_cast<std::size_t>(k)] = hold ? 1 : 0;
+        held += hold;
+    }
+    if (held == 0) return fail(p + ".pins: " + what + "'s COLOR_0 paints no vertex held (red >= 0.5)");
+    if (!painted && params.fitting_rows >= m) return fail(p + ".fitting_rows: " + std::to_string(params.fitting_rows) + " of " + std::to_string(m) + " rows");
+    out.how = how + (closed ? ", closed" : ", open") + ", " + std::to_string(held) + " particles held (" +
+              (painted ? "painted" : "the upper edge") + ")";
+    return out;
+}
+
+Result<std::string> place_on_current_pose(const Registry& registry, Entity character, GarmentPose pose, GarmentMeshAsset& mesh,
+                                          std::string_view name) {
+    if (pose == GarmentPose::current) return std::string("modelled on the character as it stands");
+    const auto* skin = registry.try_get<SkinnedMesh>(character);
+    const auto* skeleton = registry.try_get<Skeleton>(character);
+    if (!skin || !skin->mesh || skin->mesh->indices.empty() || !skeleton || !skeleton->asset ||
+        skeleton->skinning.size() != skeleton->asset->size())
+        return fail(std::string(name) + ".modelled_on: the character has no skin and skeleton to place a bind-pose garment by");
+    const MeshAsset& body = *skin->mesh;
+    const SkeletonAsset& bones = *skeleton->asset;
+    // The trunk: every bone but the limbs (each chain's first bone and what hangs from it).
+    std::vector<char> trunk(bones.size(), 1);
+    const auto* landmarks = registry.try_get<BodyLandmarks>(character);
+    if (landmarks)
+        for (const LimbChain* limb : {&landmarks->left_leg, &landmarks->right_leg, &landmarks->left_arm, &landmarks->right_arm})
+            if (limb->root >= 0 && static_cast<std::size_t>(limb->root) < bones.size()) trunk[static_cast<std::size_t>(limb->root)] = 0;
+    for (std::size_t b = 0; b < bones.size(); ++b)  // parents precede children
+        if (bones.parents[b] >= 0 && !trunk[static_cast<std::size_t>(bones.parents[b])]) trunk[b] = 0;
+    // The skin the trunk moves: triangles whose vertices each hang from it for the most part.
+    const auto trunk_share = [&](std::uint32_t v) {
+        Real share = 0;
+        for (int i = 0; i < 4; ++i) {
+            const int bone = body.bone_indices(i, v);
+            if (bone >= 0 && static_cast<std::size_t>(bone) < bones.size() && trunk[static_cast<std::size_t>(bone)]) share += body.bone_weights(i, v);
+        }
+        return share;
+    };
+    std::vector<std::uint32_t> trunk_triangles;
+    for (std::size_t t = 0; t + 2 < body.indices.size(); t += 3)
+        if (trunk_share(body.indices[t]) >= Real(0.5) && trunk_share(body.indices[t + 1]) >= Real(0.5) && trunk_share(body.indices[t + 2]) >= Real(0.5))
+            trunk_triangles.insert(trunk_triangles.end(), {body.indices[t], body.indices[t + 1], body.indices[t + 2]});
+    if (trunk_triangles.empty())
+        return fail(std::string(name) + ".modelled_on: no skin of the character's trunk to place a bind-pose garment by");
+    const SkinSurface bind(body.bind_positions, body.bind_normals, trunk_triangles);
+    Real moved = 0;
+    for (Eigen::Index v = 0; v < mesh.positions.cols(); ++v) {
+        const Eigen::Vector3d p = mesh.positions.col(v).cast<double>();
+        const SkinSurface::Closest c = bind.closest(p);
+        if (c.triangle < 0) continue;
+        const auto& t = bind.triangle(static_cast<std::size_t>(c.triangle));
+        // The influences of the triangle's vertices on the trunk's bones, weighted by the
+        // closest point's barycentric weights, blended and renormalised.
+        Eigen::Matrix<double, 3, 4> blend = Eigen::Matrix<double, 3, 4>::Zero();
+        double total = 0;
+        for (int k = 0; k < 3; ++k)
+            for (int i = 0; i < 4; ++i) {
+                const std::uint32_t vertex = t[static_cast<std::size_t>(k)];
+                const int bone = body.bone_indices(i, vertex);
+                const double w = c.weights[k] * double(body.bone_weights(i, vertex));
+                if (w <= 0 || bone < 0 || static_cast<std::size_t>(bone) >= bones.size() || !trunk[static_cast<std::size_t>(bone)]) continue;
+                blend += w * skeleton->skinning[static_cast<std::size_t>(bone)].matrix().topRows<3>().cast<double>();
+                total += w;
+            }
+        if (total <= 0) continue;
+        const Vec3 placed = (blend / total * p.homogeneous()).cast<Real>();
+        moved = std::max(moved, (placed - mesh.positions.col(v)).norm());
+        mesh.positions.col(v) = placed;
+    }
+    std::ostringstream how;
+    how.precision(1);
+    how << std::fixed << "modelled on the bind pose: placed on the current pose by the trunk's skin weights (moved up to " << 100 * moved
+        << " cm)" << (landmarks ? "" : " (no body landmarks: every bone taken as the trunk)");
+    return how.str();
+}
+
+Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const GarmentMeshAsset& authored, const MeshGarmentParams& params,
+                                   std::string_view name) {
+    GarmentMeshAsset mesh = authored;
+    if (auto placed = place_on_current_pose(registry, character, params.modelled_on, mesh, name); !placed)
+        return std::unexpected(placed.error());
+    auto grid = grid_from_mesh(mesh, params, name);
+    if (!grid) return std::unexpected(grid.error());
+    auto garment = attach_grid_garment(registry, character, grid->grid, name);
+    if (!garment) return garment;
+    // Drawn as authored: the mesh itself, carried by the grid's particles.
+    registry.emplace_or_replace(*garment, embed_surface(mesh, grid->grid, *registry.get<Garment>(*garment).fabric));
+    return garment;
+}
+
+Result<Entity> attach_garment_file(Registry& registry, Entity character, const std::filesystem::path& file, std::string_view mesh_name,
+                                   const MeshGarmentParams& params, std::string_view name) {
+    auto mesh = import_garment_mesh(file, mesh_name);
+    if (!mesh) return std::unexpected(mesh.error());
+    return attach_mesh_garment(registry, character, *mesh, params, name);
+}
+
+GarmentMeshAsset garment_as_mesh(Registry& registry, Entity garment) {
+    const Garment& g = registry.get<Garment>(garment);
+    const Fabric& f = *g.fabric;
+    const auto n = static_cast<int>(f.warp_lines), m = static_cast<int>(f.particles_per_line);
+    const int columns = f.closed ? n + 1 : n;
+    const auto* transform = registry.try_get<Transform>(g.body.character);
+    const Affine3 to_model = transform ? Affine3(transform->matrix().inverse()) : Affine3::Identity();
+    std::vector<std::uint8_t> held(f.particle_count(), 0);
+    for (const PinBinding& pin : g.state.pins) held[pin.particle] = 1;
+    GarmentMeshAsset mesh;
+    mesh.name = "Garment";
+    mesh.positions.resize(3, columns * m);
+    mesh.uvs.resize(2, columns * m);
+    mesh.pin.resize(columns * m);
+    for (int column = 0; column < columns; ++column)
+        for (int row = 0; row < m; ++row) {
+            const std::uint32_t particle = f.grid[static_cast<std::size_t>((column % n) * m + row)];
+            const int v = column * m + row;
+            mesh.positions.col(v) = to_model * Vec3(f.rest_shape.col((column % n) * m + row));
+            mesh.uvs.col(v) = Eigen::Vector2f(Real(column) / Real(f.closed ? n : n - 1), Real(row) / Real(m - 1));
+            mesh.pin[v] = held[particle] ? 1 : 0;
+        }
+    // Two triangles a quad, facing out as the garment's own (components/garment.hpp).
+    for (int column = 0; column + 1 < columns; ++column)
+        for (int row = 0; row + 1 < m; ++row) {
+            const auto a = static_cast<std::uint32_t>(column * m + row), b = a + static_cast<std::uint32_t>(m);
+            mesh.indices.insert(mesh.indices.end(), {a, a + 1, b, b, a + 1, b + 1});
+        }
+    return mesh;
+}
+
+}  // namespace drape

@@ -1,0 +1,105 @@
+// Garments from files (docs/garments.md): a mesh an artist modelled on a character turned
+// into the paper's particle grid (method §3.2), and the built-in garments written back as
+// such meshes.
+//
+// The grid comes from the mesh's pattern (UV) space: u across the grain (the weft), v along
+// it (the warp). A mesh of one panel whose vertices already form a u x v lattice is used as
+// it is (the files `drape export-garment` writes). Any other is resampled, panel by panel
+// (a panel: a connected piece of the mesh): rows at the same shares of each panel's v
+// extent, `spacing_m` apart on the longest; across each row, the panel's lines spread
+// evenly from its one edge to the other at that level (a flared piece's lines fan out, as
+// the built-in cone's do), a multiple of weft_stride segments, `spacing_m` apart on its
+// mean width; each grid point placed on the surface through the UV triangle that holds it.
+// The panels are then sewn side by side into one grid, each where one of its side edges
+// meets the previous one's on the surface, row for row; where the last meets the first,
+// the weft closes round the body. Row 0 is the held edge.
+//
+// Where it is held: painted (COLOR_0's red >= 0.5, read at each grid point through its
+// triangle), or else the v-edge that lies higher on the body, its `fitting_rows` rows.
+//
+// The pose it was modelled on: as the character stands when the garment is put on, or its
+// bind pose (as an artist models on a character in Blender), then first placed on the
+// current pose by the skin's weights: each vertex moved as the closest point of the bind
+// pose's trunk skin is (the influences of its triangle's vertices on the trunk's bones,
+// blended by the point's barycentric weights). The trunk, not the limbs: a skirt between the
+// legs or a cape beside an arm is carried by the hips and the spine, and the cloth then
+// finds the limbs where they are.
+//
+// Not yet: panels that a level of v crosses twice (straps, slits, holes), panels sewn
+// other than side by side (a yoke, a gusset), and meshes without UVs (which would need the
+// classic model on their own edges); each is refused with one line that says so.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "drape/components/garment.hpp"
+#include "drape/engine/assets/garment_file.hpp"
+#include "drape/engine/core/error.hpp"
+#include "drape/engine/core/registry.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
+
+namespace drape {
+
+/// Where a garment from a mesh is held.
+enum class PinSource : std::uint8_t {
+    file,       ///< Painted where the file paints (COLOR_0), else automatic.
+    painted,    ///< Painted; a file without COLOR_0 is an error.
+    automatic,  ///< The higher v-edge's `fitting_rows` rows, whatever the file paints.
+};
+
+/// The pose a garment's mesh was modelled on.
+enum class GarmentPose : std::uint8_t {
+    current,  ///< The character as it stands when the garment is put on: used as it is.
+    bind,     ///< The character's bind pose: placed on its current pose by the trunk's skin weights.
+};
+
+/// How a mesh becomes a grid, and the cloth it is.
+struct MeshGarmentParams {
+    Real spacing_m = 0;        ///< Between warp lines and weft rows; 0: the mesh's own lattice where it is one, else 0.029 m.
+    int weft_stride = 3;       ///< Every weft_stride-th line is layer 1 (method §3.2).
+    PinSource pins = PinSource::file;
+    int fitting_rows = 1;      ///< Rows held when the pins are automatic.
+    GarmentPose modelled_on = GarmentPose::current;
+    GarmentConfig config;      ///< Model, integrator, collision, material, inertia, colour.
+};
+
+/// The grid `mesh` gives (see above), in the mesh's space, and one line on how it was made
+/// ("a 27 x 31 lattice of the mesh's own vertices, closed, 27 particles painted").
+struct MeshGrid {
+    GridGarment grid;
+    std::string how;
+};
+
+/// Turns `mesh` into a grid; errors are prefixed with `name`.
+[[nodiscard]] Result<MeshGrid> grid_from_mesh(const GarmentMeshAsset& mesh, const MeshGarmentParams& params, std::string_view name);
+
+/// Moves `mesh` (in `character`'s model space) from the pose it was modelled on to the
+/// character's current pose (see above; nothing moves for GarmentPose::current). Returns one
+/// line on what it did; errors are prefixed with `name` (the bind pose asked of a character
+/// without skin, skeleton or trunk).
+[[nodiscard]] Result<std::string> place_on_current_pose(const Registry& registry, Entity character, GarmentPose pose,
+                                                        GarmentMeshAsset& mesh, std::string_view name);
+
+/// `mesh` (in `character`'s model space, modelled on the pose params.modelled_on says) as
+/// cloth on `character` (attach_grid_garment).
+[[nodiscard]] Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const GarmentMeshAsset& mesh,
+                                                 const MeshGarmentParams& params, std::string_view name);
+
+/// The one call: the garment mesh `mesh_name` of `file` (its only mesh when empty;
+/// import_garment_mesh) as cloth on `character`. Errors name the file or the field.
+[[nodiscard]] Result<Entity> attach_garment_file(Registry& registry, Entity character, const std::filesystem::path& file,
+                                                 std::string_view mesh_name = {}, const MeshGarmentParams& params = {},
+                                                 std::string_view name = "garment");
+
+/// `garment`'s cut as a mesh in its character's model space: its particle grid as it was
+/// built (Fabric::rest_shape, the shape its rest lengths were measured on, before it was
+/// pushed out of the body; the character standing where it stood then), with u = line /
+/// lines (a tube's first line written again at u = 1, so that the pattern opens at a seam),
+/// v = row / (rows - 1), and its pins painted. Read back and put on the same character in
+/// the same pose, it is the same garment.
+[[nodiscard]] GarmentMeshAsset garment_as_mesh(Registry& registry, Entity garment);
+
+}  // namespace drape
