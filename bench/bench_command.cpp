@@ -28,6 +28,7 @@ const std::vector<Benchmark>& benchmarks() {
         {"quality", "after-frame strain, penetration, cost and shape against a converged reference, per garment x model x character", run_quality},
         {"motions", "every character x each clip a garment is played on and root motions x garment x model x start, judged by the contract", run_motions},
         {"garments", "garments from files (four cut garments) on every character's walk and run, judged by the contract, cost per particle", run_garments},
+        {"cut", "the hem's radius on a still body, simplified against classic, per character and garment", run_cut},
     };
     return list;
 }

@@ -135,5 +135,6 @@ struct Benchmark {
 [[nodiscard]] Result<void> run_quality(const BenchOptions& options);
 [[nodiscard]] Result<void> run_motions(const BenchOptions& options);
 [[nodiscard]] Result<void> run_garments(const BenchOptions& options);
+[[nodiscard]] Result<void> run_cut(const BenchOptions& options);
 
 }  // namespace drape::bench
