@@ -8,6 +8,7 @@
 // close the outputs, print the budget and the verdict, write the reports. Nothing is written before every
 // input has been checked and the world is built; a step that fails prints one line and
 // leaves nothing the run created behind (CreatedOutputs, game/output_files.hpp).
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -289,6 +290,7 @@ struct PlayRun {
     int played = 0;                   ///< Frames played.
     std::uint64_t dropped_frames = 0; ///< Frames that dropped simulated time (hitches).
     bool interrupted = false;         ///< Stopped by Ctrl-C.
+    std::vector<double> wall_ms;      ///< Each frame's whole wall-clock time: its step, drawing, presenting, writing.
 };
 
 #ifdef DRAPE_HAVE_RENDER
@@ -375,8 +377,8 @@ Result<PlayRun> run_frames(World& world, const PlayOptions& o, const PlaySetting
     const InterruptScope interrupts;
     while ((frames == 0 || run.played < frames) && !g_interrupted) {
         double dt = frame_dt_s;
-#ifdef DRAPE_HAVE_RENDER
         const auto start = std::chrono::steady_clock::now();
+#ifdef DRAPE_HAVE_RENDER
         if (s.window && !control.next_frame(world, dt)) break;
 #endif
         auto ticked = step_world(world, dt);
@@ -397,6 +399,7 @@ Result<PlayRun> run_frames(World& world, const PlayOptions& o, const PlaySetting
 #else
         (void)out;
 #endif
+        run.wall_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     }
     run.interrupted = g_interrupted != 0;
     return run;
@@ -419,6 +422,17 @@ Result<void> close_outputs(PlayOutputs& out, int played) {
 // 8. The frame budget and where the frames went.
 void print_budget(const World& world, const PlayRun& run, const PlayOutputs& out, const PlaySettings& s) {
     std::fputs(world.scheduler.profiler().table().c_str(), stdout);
+    if (!run.wall_ms.empty()) {
+        // The systems above are the simulation's and the drawing's share; a frame's wall time
+        // also holds presenting, reading back and writing the frames or the video.
+        std::vector<double> w = run.wall_ms;
+        std::sort(w.begin(), w.end());
+        const auto at = [&](double q) { return w[std::min(w.size() - 1, static_cast<std::size_t>(q * double(w.size())))]; };
+        double sum = 0;
+        for (const double v : w) sum += v;
+        std::printf("%-28s %8zu %8s %9.4f %9.4f %9.4f %9.4f\n", "whole frame (wall clock)", w.size(), "", sum / double(w.size()),
+                    at(0.5), at(0.95), w.back());
+    }
     std::printf("%d frames, %.2f s simulated", run.played, world.scheduler.time_s());
     if (world.scheduler.total_dropped_s() > 0)
         std::printf(", %.3f s dropped in %llu hitch frame(s)", world.scheduler.total_dropped_s(),

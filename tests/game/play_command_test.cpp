@@ -269,6 +269,8 @@ TEST_F(PlayCommand, HeadlessRunWritesStatsAndTrace) {
     const PlayRun run = play("--headless --frames 5 --stats stats.json --trace trace.json", m_dir);
     ASSERT_EQ(run.status, 0) << run.output;
     EXPECT_NE(run.output.find("Frame budget"), std::string::npos) << run.output;
+    // The table ends with the whole frame's wall-clock time, over every frame played.
+    EXPECT_NE(run.output.find("\nwhole frame (wall clock)            5 "), std::string::npos) << run.output;
     std::ifstream in(m_dir / "stats.json");
     const nlohmann::json stats = nlohmann::json::parse(in);
     EXPECT_EQ(stats["frames"], 5);
