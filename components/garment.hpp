@@ -53,6 +53,14 @@ enum class ClothIntegrator : std::uint8_t {
               ///< substeps from its stability bound.
 };
 
+/// How the shipped solver's rounds solve the warp springs (docs/cloth.md "Warp lines solved
+/// directly").
+enum class WarpSolve : std::uint8_t {
+    rounds,  ///< Gauss-Seidel, spring by spring, as every other set; tethers at the lines' rest length.
+    lines,   ///< Each warp line at once (a tridiagonal solve per line), tethers with the warp
+             ///< limit's slack: a line hangs at the stretch its modulus gives.
+};
+
 /// How particles find the ellipsoids they touch (method §5).
 enum class CollisionMode : std::uint8_t {
     candidate_lists,  ///< Per-particle candidate lists + last-collided first.
@@ -134,6 +142,7 @@ struct InertiaScales {
 struct GarmentConfig {
     ClothModel model = ClothModel::simplified;
     ClothIntegrator integrator = ClothIntegrator::shipped;
+    WarpSolve warp_solve = WarpSolve::rounds;  ///< The shipped integrator's only.
     CollisionMode collision = CollisionMode::candidate_lists;
     ClothMaterial material;
     InertiaScales inertia;

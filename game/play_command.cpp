@@ -45,7 +45,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct PlayOptions {
-    std::string scene, character, clip, motion, garment, model, integrator, out, video, trace, stats, size;
+    std::string scene, character, clip, motion, garment, model, integrator, warp_solve, out, video, trace, stats, size;
     std::optional<int> frames;
     std::optional<int> threads;
     std::optional<int> trace_size;
@@ -191,6 +191,7 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
             if (!scene.garments.empty()) {  // keep the look and solver choices of the scene's garment
                 g.model = scene.garments[0].model;
                 g.integrator = scene.garments[0].integrator;
+                g.warp_solve = scene.garments[0].warp_solve;
                 g.collision = scene.garments[0].collision;
                 g.color = scene.garments[0].color;
                 if (built_in && scene.garments[0].file.empty() && scene.garments[0].type == g.type) g.parameters = scene.garments[0].parameters;
@@ -204,6 +205,8 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
     if (!o.integrator.empty())
         for (GarmentDescription& g : scene.garments)
             g.integrator = o.integrator == "paper" ? ClothIntegrator::paper : ClothIntegrator::shipped;
+    if (!o.warp_solve.empty())
+        for (GarmentDescription& g : scene.garments) g.warp_solve = o.warp_solve == "lines" ? WarpSolve::lines : WarpSolve::rounds;
     if (o.threads) scene.solver.threads = *o.threads;
     if (o.time_scale) scene.solver.time_scale = *o.time_scale;
     return {};
@@ -559,6 +562,9 @@ void add_play_command(CLI::App& app) {
     play_app->add_option("--integrator", o->integrator,
                          "Garment integrator: the shipped solver or the paper's explicit scheme (docs/cloth.md)")
         ->check(one_of({"shipped", "paper"}));
+    play_app->add_option("--warp-solve", o->warp_solve,
+                         "The shipped solver's warp springs: Gauss-Seidel rounds or each line at once (docs/cloth.md)")
+        ->check(one_of({"rounds", "lines"}));
     play_app->add_option("--frames", o->frames, "Frames to play (default 240; in a window: until closed)")
         ->check(integer_in(1, 10'000'000));
     play_app->add_flag("--headless", o->headless, "No rendering at all (no render system)");

@@ -77,6 +77,7 @@ struct GarmentDescription {
     int character = 0;                                   ///< Index into SceneDescription::characters.
     ClothModel model = ClothModel::simplified;
     ClothIntegrator integrator = ClothIntegrator::shipped;  ///< docs/cloth.md "Two integrators".
+    WarpSolve warp_solve = WarpSolve::rounds;            ///< docs/cloth.md "Warp lines solved directly".
     CollisionMode collision = CollisionMode::candidate_lists;
     std::optional<Vec3> color;                           ///< Linear RGB in [0, 1]; none: the garment's default.
     std::string material;                                ///< A material preset (silk, cotton, denim); empty: cotton.

@@ -479,6 +479,8 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
     if (const Json* v = f.get("integrator"))
         g.integrator = read_choice<ClothIntegrator>(r, f.path("integrator"), *v,
                                                     {{"shipped", ClothIntegrator::shipped}, {"paper", ClothIntegrator::paper}});
+    if (const Json* v = f.get("warp_solve"))
+        g.warp_solve = read_choice<WarpSolve>(r, f.path("warp_solve"), *v, {{"rounds", WarpSolve::rounds}, {"lines", WarpSolve::lines}});
     if (const Json* v = f.get("collision"))
         g.collision = read_choice<CollisionMode>(r, f.path("collision"), *v,
                                                  {{"lists", CollisionMode::candidate_lists}, {"brute_force", CollisionMode::brute_force}});
@@ -731,6 +733,7 @@ std::string to_json(const SceneDescription& scene) {
         o["character"] = g.character;
         o["model"] = cloth_model_name(g.model);
         if (g.integrator != ClothIntegrator::shipped) o["integrator"] = cloth_integrator_name(g.integrator);
+        if (g.warp_solve != WarpSolve::rounds) o["warp_solve"] = "lines";
         o["collision"] = collision_mode_name(g.collision);
         if (g.color) o["color"] = vec(*g.color);
         if (!g.material.empty()) o["material"] = g.material;

@@ -234,6 +234,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
                                        : g.type == GarmentType::skirt ? attach_skirt(world.registry, body, *params)
                                                                       : attach_dress(world.registry, body, *params);
         if (!garment) return fail(located(g.where, field, garment.error().message));
+        world.registry.get<Garment>(*garment).config.warp_solve = g.warp_solve;
         world.garments.push_back(*garment);
     }
     // A garment simulated over one modelled into the file: the modelled one is not drawn.

@@ -178,6 +178,198 @@ void solve_edge_springs(SpringSet& set, Matrix3XRows& x, const VectorX& w, Real 
     solve_edge_strips(set, {x.row(0).data(), x.row(1).data(), x.row(2).data()}, 1, w, h, limit);
 }
 
+bool line_chains(SpringSet& set) {
+    const SpringPhase& sp = *set.springs;
+    const std::size_t n = sp.size();
+    std::uint32_t particles = 0;
+    for (std::size_t k = 0; k < n; ++k) particles = std::max({particles, sp.a[k] + 1, sp.b[k] + 1});
+    std::vector<std::uint32_t> upper_end_of(particles, no_spring);  // per particle: the spring it is the upper end of
+    for (std::size_t k = 0; k < n; ++k) upper_end_of[sp.a[k]] = static_cast<std::uint32_t>(k);
+    set.prev.assign(n, no_spring);
+    set.next.assign(n, no_spring);
+    for (std::size_t k = 0; k < n; ++k) {
+        set.next[k] = upper_end_of[sp.b[k]];
+        if (set.next[k] != no_spring) set.prev[set.next[k]] = static_cast<std::uint32_t>(k);
+    }
+    const std::size_t bands = set.strips.parts.size();
+    set.aligned_prev.assign(bands, {});
+    set.aligned_next.assign(bands, {});
+    std::vector<char> seen(n, 0);
+    bool ordered = set.strips.edge.empty();
+    for (std::size_t band = 0; band < bands && ordered; ++band) {
+        const std::vector<SpringStrip>& strips = set.strips.parts[band];
+        std::vector<std::uint8_t>& up = set.aligned_prev[band];
+        std::vector<std::uint8_t>& down = set.aligned_next[band];
+        up.assign(strips.size(), 0);
+        down.assign(strips.size(), 0);
+        for (std::size_t j = 0; j < strips.size() && ordered; ++j) {
+            const SpringStrip& st = strips[j];
+            bool up_ok = j > 0 && st.stride == 1 && strips[j - 1].stride == 1 && strips[j - 1].count >= st.count;
+            for (std::uint32_t k = 0; k < st.count; ++k) {
+                const std::uint32_t s = st.first + k * st.stride;
+                ordered = ordered && (set.prev[s] == no_spring || seen[set.prev[s]]);
+                seen[s] = 1;
+                up_ok = up_ok && set.prev[s] == strips[j - 1].first + k;
+            }
+            up[j] = up_ok;
+            if (up_ok) {
+                // Strip j - 1's lanes beyond st.count have no spring below them in strip j.
+                bool down_ok = true;
+                for (std::uint32_t k = st.count; k < strips[j - 1].count; ++k)
+                    down_ok = down_ok && set.next[strips[j - 1].first + k] == no_spring;
+                down[j - 1] = down_ok;
+            }
+        }
+    }
+    if (!ordered) {
+        set.prev.clear();
+        set.next.clear();
+        return false;
+    }
+    for (auto* v : {&set.dir0, &set.dir1, &set.dir2, &set.offdiag, &set.pivot, &set.rhs}) v->assign(n, 0);
+    return true;
+}
+
+namespace {
+
+// solve_lines' first sweep over one strip: each spring's direction, diagonal
+// w_a + w_b + alpha~ and right-hand side -C - alpha~ lambda.
+template <int Stride>
+void line_strip_terms(std::uint32_t count, const Real* __restrict a0, const Real* __restrict a1, const Real* __restrict a2,
+                      const Real* __restrict b0, const Real* __restrict b1, const Real* __restrict b2,
+                      const Real* __restrict wa, const Real* __restrict wb, const Real* __restrict rest,
+                      const Real* __restrict compliance, const Real* __restrict lambda, Real inv_h2, Real* __restrict u0,
+                      Real* __restrict u1, Real* __restrict u2, Real* __restrict pivot, Real* __restrict rhs) {
+#pragma GCC ivdep
+    for (int k = 0; k < int(count); ++k) {
+        const int i = k * Stride;
+        const Real d0 = b0[i] - a0[i], d1 = b1[i] - a1[i], d2 = b2[i] - a2[i];
+        const Real length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+        const Real inv = 1 / std::max(length, Real(1e-12));  // coincident ends: no direction, no move
+        u0[i] = d0 * inv;
+        u1[i] = d1 * inv;
+        u2[i] = d2 * inv;
+        const Real alpha = compliance[i] * inv_h2;
+        pivot[i] = std::max(wa[i] + wb[i] + alpha, Real(1e-30));
+        rhs[i] = rest[i] - length - alpha * lambda[i];
+    }
+}
+
+// solve_lines' elimination of a strip's coupling with the strip above it, lane by lane:
+// c = -w_shared (u_above . u), pivot -= c^2 / pivot_above, rhs -= c rhs_above / pivot_above.
+void eliminate_strip(int count, const Real* __restrict w_shared, const Real* __restrict v0, const Real* __restrict v1,
+                     const Real* __restrict v2, const Real* __restrict pivot_above, const Real* __restrict rhs_above,
+                     const Real* __restrict u0, const Real* __restrict u1, const Real* __restrict u2, Real* __restrict off,
+                     Real* __restrict pivot, Real* __restrict rhs) {
+    for (int k = 0; k < count; ++k) {
+        const Real c = -w_shared[k] * (v0[k] * u0[k] + v1[k] * u1[k] + v2[k] * u2[k]);
+        const Real q = c / pivot_above[k];
+        off[k] = c;
+        pivot[k] = std::max(pivot[k] - c * q, Real(1e-30));
+        rhs[k] -= q * rhs_above[k];
+    }
+}
+
+// solve_lines' last sweep over one strip: each spring's multiplier and its ends' moves.
+template <int Stride>
+void line_strip_moves(std::uint32_t count, Real* __restrict a0, Real* __restrict a1, Real* __restrict a2,
+                      Real* __restrict b0, Real* __restrict b1, Real* __restrict b2, const Real* __restrict wa,
+                      const Real* __restrict wb, const Real* __restrict u0, const Real* __restrict u1,
+                      const Real* __restrict u2, const Real* __restrict dl_, Real* __restrict lambda) {
+#pragma GCC ivdep
+    for (int k = 0; k < int(count); ++k) {
+        const int i = k * Stride;
+        const Real dl = dl_[i];
+        lambda[i] += dl;
+        const Real m0 = dl * u0[i], m1 = dl * u1[i], m2 = dl * u2[i];
+        a0[i] -= wa[i] * m0;
+        a1[i] -= wa[i] * m1;
+        a2[i] -= wa[i] * m2;
+        b0[i] += wb[i] * m0;
+        b1[i] += wb[i] * m1;
+        b2[i] += wb[i] * m2;
+    }
+}
+
+}  // namespace
+
+void solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& w_, Real h) {
+    const SpringPhase& sp = *set.springs;
+    Real* x0 = x.row(0).data();
+    Real* x1 = x.row(1).data();
+    Real* x2 = x.row(2).data();
+    const Real* w = w_.data();
+    const Real inv_h2 = 1 / (h * h);
+    const Real* rest = sp.rest_m.data();
+    const Real* compliance = set.compliance.data();
+    Real* lambda = set.lambda.data();
+    Real* __restrict u0 = set.dir0.data();
+    Real* __restrict u1 = set.dir1.data();
+    Real* __restrict u2 = set.dir2.data();
+    Real* __restrict off = set.offdiag.data();  // per spring: its coupling with the spring above it
+    Real* __restrict pivot = set.pivot.data();
+    Real* __restrict rhs = set.rhs.data();      // the right-hand side, eliminated, then the multiplier's change
+    const std::uint32_t* prev = set.prev.data();
+    const std::uint32_t* next = set.next.data();
+    const std::vector<SpringStrip>& strips = set.strips.parts[band];
+    const std::vector<std::uint8_t>& aligned_prev = set.aligned_prev[band];
+    const std::vector<std::uint8_t>& aligned_next = set.aligned_next[band];
+    // From the pins down, strip by strip (a strip is a row of lines): each spring's terms,
+    // then the elimination of its coupling with the spring above it, -w_shared (u_above . u).
+    for (std::size_t j = 0; j < strips.size(); ++j) {
+        const SpringStrip& st = strips[j];
+        const std::uint32_t count = st.count, stride = st.stride, f = st.first, a = st.a, b = st.b;
+        if (stride == 1)
+            line_strip_terms<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, rest + f, compliance + f,
+                                lambda + f, inv_h2, u0 + f, u1 + f, u2 + f, pivot + f, rhs + f);
+        else
+            line_strip_terms<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, rest + f, compliance + f,
+                                lambda + f, inv_h2, u0 + f, u1 + f, u2 + f, pivot + f, rhs + f);
+        if (j > 0 && aligned_prev[j]) {
+            eliminate_strip(int(count), w + a, u0 + strips[j - 1].first, u1 + strips[j - 1].first, u2 + strips[j - 1].first,
+                            pivot + strips[j - 1].first, rhs + strips[j - 1].first, u0 + f, u1 + f, u2 + f, off + f, pivot + f,
+                            rhs + f);
+        } else {
+            for (std::uint32_t k = 0; k < count; ++k) {
+                const std::uint32_t s = f + k * stride, p = prev[s];
+                off[s] = 0;
+                if (p == no_spring) continue;
+                const Real c = -w[a + k * stride] * (u0[p] * u0[s] + u1[p] * u1[s] + u2[p] * u2[s]);
+                const Real q = c / pivot[p];
+                off[s] = c;
+                pivot[s] = std::max(pivot[s] - c * q, Real(1e-30));
+                rhs[s] -= q * rhs[p];
+            }
+        }
+    }
+    // From the hem up: each multiplier's change, then its spring's move (the directions and
+    // the springs above no longer need the positions).
+    for (std::size_t j = strips.size(); j-- > 0;) {
+        const SpringStrip& st = strips[j];
+        const std::uint32_t count = st.count, stride = st.stride, f = st.first, a = st.a, b = st.b;
+        if (aligned_next[j]) {
+            const int below = int(strips[j + 1].count);
+            Real* __restrict y = rhs + f;
+            const Real* __restrict y_below = rhs + strips[j + 1].first;
+            const Real* __restrict c_below = off + strips[j + 1].first;
+            const Real* __restrict p = pivot + f;
+            for (int k = 0; k < below; ++k) y[k] = (y[k] - c_below[k] * y_below[k]) / p[k];
+            for (int k = below; k < int(count); ++k) y[k] /= p[k];
+        } else {
+            for (std::uint32_t k = 0; k < count; ++k) {
+                const std::uint32_t s = f + k * stride, t = next[s];
+                rhs[s] = (rhs[s] - (t == no_spring ? Real(0) : off[t] * rhs[t])) / pivot[s];
+            }
+        }
+        if (stride == 1)
+            line_strip_moves<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, u0 + f, u1 + f, u2 + f,
+                                rhs + f, lambda + f);
+        else
+            line_strip_moves<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, u0 + f, u1 + f, u2 + f,
+                                rhs + f, lambda + f);
+    }
+}
+
 VectorX warp_rest_above(const Fabric& f) {
     VectorX above = VectorX::Zero(static_cast<Eigen::Index>(f.particle_count()));
     for (const SpringPhase* phase : {&f.warp1, &f.warp2})

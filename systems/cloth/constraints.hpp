@@ -6,9 +6,11 @@
 //      stretch spring of stiffness k as an XPBD constraint of compliance 1/k (the implicit
 //      response of the same Hooke spring, stable at any stiffness), then Provot's limit: a
 //      spring still longer than (1 + limit) x rest has its ends moved back to the limit,
-//      shared by inverse mass (a pinned end stays).
+//      shared by inverse mass (a pinned end stays). With WarpSolve::lines the warp sets
+//      are solved line by line instead (solve_lines), each line's springs at once.
 //   2. Tethers: a free particle no farther from the pinned particle at the top of its warp
-//      line than the rest length of the line between them (long-range attachments, as Jolt
+//      line than the rest length of the line between them (with WarpSolve::lines, that
+//      times 1 + limit_share x limit; long-range attachments, as Jolt
 //      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
 //      line's weight up to its pin, the tether does it in one).
 // After the rounds, once per substep, limit_warp_lines holds every warp spring within half
@@ -60,7 +62,29 @@ struct SpringSet {
     std::vector<Real> compliance;  ///< Per spring: 1 / k, m/N (1e30: a spring without force).
     std::vector<Real> lambda;      ///< Per spring: XPBD multiplier of the current substep.
     bool limited = true;           ///< Provot's limit applies (structural springs).
+    /// Warp lines solved directly (solve_lines; see line_chains): per spring the springs
+    /// above and below it on its line (no_spring: none), per band and strip whether the
+    /// strips before and after it hold those one lane to one lane, and the chain solve's
+    /// scratch. Empty `next`: Gauss-Seidel strips (solve_springs).
+    std::vector<std::uint32_t> prev, next;
+    std::vector<std::vector<std::uint8_t>> aligned_prev, aligned_next;
+    std::vector<Real> dir0, dir1, dir2, offdiag, pivot, rhs;
 };
+
+inline constexpr std::uint32_t no_spring = 0xffffffffu;
+
+/// Sets `set` (a warp phase, its strips made) up for solve_lines: the springs above and
+/// below each spring on its line. Returns false, leaving it to the Gauss-Seidel strips,
+/// when a band's strips do not run from the pins down (a spring before the one above it).
+bool line_chains(SpringSet& set);
+
+/// One round over band `band` of a warp set solved along its lines (line_chains; instead
+/// of solve_springs): each line's springs are one chain whose XPBD constraints, linearised
+/// at the current positions, are solved at once, a tridiagonal system per line (Thomas),
+/// so that one round hangs a line at the stretch its modulus gives, however long the line
+/// and stiff the cloth. The multipliers accumulate over the substep's rounds as in
+/// solve_springs. Provot's limit is left to the warp limit after the rounds.
+void solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& inv_mass, Real h_s);
 
 /// Per spring: 1 / k with k = modulus x (area_a + area_b) / (2 rest^2) (components/garment.hpp).
 /// `area` per particle; a modulus of 0 gives a spring without force (limit only).
@@ -74,6 +98,13 @@ void solve_springs(SpringSet& set, std::size_t band, Matrix3XRows& x, const Vect
 /// particle or one row per coordinate (the same arithmetic).
 void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& inv_mass, Real h_s, Real limit);
 void solve_edge_springs(SpringSet& set, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
+
+// The warp and weft limits hold the springs within this share of Provot's limit, leaving
+// the rest of the limit to what the last collision does after them. Lower, the warp limit
+// acts on a garment at rest (the rounds leave a line hanging a few percent long over the
+// hips) and dynamic follow-the-leader's velocity correction then keeps it moving: at 2 % of
+// stretch the skirt on a still body kept 1 cm/s, at 5 % it comes to rest (docs/cloth.md).
+inline constexpr Real limit_share = Real(0.5);
 
 /// Long-range attachments (step 2): one per free particle below a pinned one on its line.
 struct Tethers {

@@ -46,6 +46,9 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
     if (!s.configured || !(s.built_for == g.config) || s.built_fabric != &t || s.built_pins != state.pins.size()) {
         if (s.configured && s.built_for.material.candidate_margin_m != g.config.material.candidate_margin_m) s.lists.valid = false;
         const ClothMaterial& m = g.config.material;
+        // Warp lines solved directly (docs/cloth.md "Warp lines solved directly"): the shipped
+        // integrator's option.
+        const bool lines = g.config.warp_solve == WarpSolve::lines && g.config.integrator == ClothIntegrator::shipped;
         s.integrated = simplified ? static_cast<Eigen::Index>(t.layer1_count) : n;
         derive_masses(g, s);
         // Stiffness from the cloth's moduli and the areas the springs' particles stand for:
@@ -61,10 +64,10 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         const GarmentParts& parts = s.parts;
         s.springs.clear();
         if (simplified) {
-            // Weft springs, then the warp: layer 1's (with the areas its particles stand for),
-            // then layer 2's.
+            // Weft springs, then the warp: layer 1's (with the areas its particles stand for;
+            // with lines their own, layer 2's lines carrying their own weight), then layer 2's.
             s.springs.push_back(spring_set(t.weft, t.area_m2, m.stretch_N_m, true, parts));
-            s.springs.push_back(spring_set(t.warp1, area, m.stretch_N_m, true, parts));
+            s.springs.push_back(spring_set(t.warp1, lines ? t.area_m2 : area, m.stretch_N_m, true, parts));
             s.springs.push_back(spring_set(t.warp2, t.area_m2, m.stretch_N_m, true, parts));
         } else {
             // Shear and bend first: the structural springs and their limit have the last word.
@@ -88,10 +91,16 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             if (!s.springs[k].limited) continue;
             (!simplified || phase == &t.warp1 ? s.provot_first : s.provot_then).push_back(k);
         }
+        if (lines)
+            for (SpringSet& set : s.springs)
+                if (set.springs == &t.warp1 || set.springs == &t.warp2) (void)line_chains(set);
         s.spring_step_s = spring_step_limit_s(s.springs, s.explicit_sets, s.paper_inv_mass);
         s.warp_rest_above = warp_rest_above(t);
         s.weft_rest_right = weft_rest_right(t);
-        s.tethers = split_tethers(build_tethers(t, state.inv_mass, s.warp_rest_above), parts.band, parts.count);
+        Tethers tethers = build_tethers(t, state.inv_mass, s.warp_rest_above);
+        if (lines)  // the warp limit's slack, so that a line can stretch as far as its springs may
+            for (Real& l : tethers.length_m) l *= 1 + limit_share * m.strain_limit;
+        s.tethers = split_tethers(tethers, parts.band, parts.count);
         s.below.resize(static_cast<std::size_t>(n));
         s.above.resize(static_cast<std::size_t>(n));
         s.grid_place.resize(static_cast<std::size_t>(n));

@@ -18,13 +18,6 @@
 
 namespace drape {
 
-// The warp and weft limits hold the springs within this share of Provot's limit, leaving
-// the rest of the limit to what the last collision does after them. Lower, the warp limit
-// acts on a garment at rest (the rounds leave a line hanging a few percent long over the
-// hips) and dynamic follow-the-leader's velocity correction then keeps it moving: at 2 % of
-// stretch the skirt on a still body kept 1 cm/s, at 5 % it comes to rest (docs/cloth.md).
-constexpr Real limit_share = Real(0.5);
-
 // Dynamic follow-the-leader's damping s_damping (Müller et al. 2012): the share of a
 // follower's warp-limit move that its leader's velocity gives back.
 constexpr Real leader_damping = Real(0.9);
@@ -165,7 +158,12 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
         if (!in_rows)
             for (const ParticleRun& r : s.parts.runs[k])
                 s.x_rows.middleCols(r.begin, r.end - r.begin) = x.middleCols(r.begin, r.end - r.begin);
-        for (SpringSet& set : s.springs) solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
+        for (SpringSet& set : s.springs) {
+            if (set.next.empty())
+                solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
+            else
+                solve_lines(set, k, s.x_rows, s.inv_mass, h);
+        }
         if (tethers) solve_tethers(s.tethers[k], s.x_rows);
         if (write_back)
             for (const ParticleRun& r : s.parts.runs[k])

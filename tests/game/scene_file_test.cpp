@@ -53,7 +53,7 @@ constexpr const char* valid_scene = R"({
   "garments": [
     {"type": "skirt", "character": 0, "model": "simplified", "collision": "lists",
      "color": [0.8, 0.1, 0.2], "particles": 837},
-    {"type": "dress", "character": 1, "model": "classic", "integrator": "paper", "collision": "brute_force"}
+    {"type": "dress", "character": 1, "model": "classic", "integrator": "paper", "collision": "brute_force"}, {"warp_solve": "lines"}
   ],
   "colliders": [
     {"character": 0, "bone": "Hips", "radii_m": [0.2, 0.15, 0.14]},
@@ -77,7 +77,7 @@ TEST_F(SceneFileTest, ValidFileIsReadCompletely) {
     EXPECT_FLOAT_EQ(scene->characters[1].position_m.x(), 1.5f);
     // Yaw 90 degrees turns +Z to +X.
     EXPECT_TRUE((scene->characters[0].rotation() * Vec3::UnitZ()).isApprox(Vec3::UnitX(), 1e-5f));
-    ASSERT_EQ(scene->garments.size(), 2u);
+    ASSERT_EQ(scene->garments.size(), 3u);
     EXPECT_EQ(scene->garments[0].type, GarmentType::skirt);
     ASSERT_EQ(scene->garments[0].parameters.size(), 1u);
     EXPECT_EQ(scene->garments[0].parameters[0].name, "particles");
@@ -86,6 +86,8 @@ TEST_F(SceneFileTest, ValidFileIsReadCompletely) {
     EXPECT_EQ(scene->garments[1].collision, CollisionMode::brute_force);
     EXPECT_EQ(scene->garments[0].integrator, ClothIntegrator::shipped);
     EXPECT_EQ(scene->garments[1].integrator, ClothIntegrator::paper);
+    EXPECT_EQ(scene->garments[1].warp_solve, WarpSolve::rounds);
+    EXPECT_EQ(scene->garments[2].warp_solve, WarpSolve::lines);
     EXPECT_FALSE(scene->garments[1].color.has_value());
     ASSERT_EQ(scene->colliders.size(), 2u);
     EXPECT_TRUE(scene->colliders[1].remove);
@@ -160,6 +162,8 @@ TEST_F(SceneFileTest, WrongTypesAreNamed) {
               "scene.json:1:68: garments[0].type: must be one of \"skirt\", \"dress\", got \"shirt\"");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "garments": [{"integrator": "implicit"}]})"),
               "scene.json:1:74: garments[0].integrator: must be one of \"shipped\", \"paper\", got \"implicit\"");
+    EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "garments": [{"warp_solve": "direct"}]})"),
+              "scene.json:1:74: garments[0].warp_solve: must be one of \"rounds\", \"lines\", got \"direct\"");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"substeps": 2.5}})"),
               "scene.json:1:69: solver.substeps: must be \"auto\" or an integer in [1, 1000], got 2.5");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"max_surface_travel_m": 0}})"),
