@@ -160,7 +160,9 @@ TEST(FrameProfiler, TraceKeepsTheMostRecentEventsAndCountsTheDropped) {
         if (ev["ph"] == "X") starts.push_back(ev["ts"].get<double>());
     ASSERT_EQ(starts.size(), 16u);
     EXPECT_TRUE(std::is_sorted(starts.begin(), starts.end())) << "oldest kept first";
-    EXPECT_DOUBLE_EQ(starts.back() - starts.front(), 15.0) << "the last 16 runs, 1 us apart";
+    // Times are microseconds from the trace's origin, in doubles: the difference of two of
+    // them is 15 us to their rounding, not to the last bit.
+    EXPECT_NEAR(starts.back() - starts.front(), 15.0, 1e-6) << "the last 16 runs, 1 us apart";
     p.reset();
     EXPECT_EQ(p.trace_events_recorded(), 0u);
     EXPECT_EQ(p.trace_events_dropped(), 0u);
