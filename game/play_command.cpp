@@ -45,7 +45,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct PlayOptions {
-    std::string scene, character, clip, motion, garment, model, integrator, warp_solve, out, video, trace, stats, size;
+    std::string scene, character, clip, motion, garment, model, integrator, warp_solve, pin_weights, out, video, trace, stats, size;
     std::optional<int> frames;
     std::optional<int> threads;
     std::optional<int> trace_size;
@@ -192,6 +192,7 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
                 g.model = scene.garments[0].model;
                 g.integrator = scene.garments[0].integrator;
                 g.warp_solve = scene.garments[0].warp_solve;
+                g.pin_weights = scene.garments[0].pin_weights;
                 g.collision = scene.garments[0].collision;
                 g.color = scene.garments[0].color;
                 if (built_in && scene.garments[0].file.empty() && scene.garments[0].type == g.type) g.parameters = scene.garments[0].parameters;
@@ -207,6 +208,9 @@ Result<void> apply_overrides(SceneDescription& scene, const PlayOptions& o) {
             g.integrator = o.integrator == "paper" ? ClothIntegrator::paper : ClothIntegrator::shipped;
     if (!o.warp_solve.empty())
         for (GarmentDescription& g : scene.garments) g.warp_solve = o.warp_solve == "lines" ? WarpSolve::lines : WarpSolve::rounds;
+    if (!o.pin_weights.empty())
+        for (GarmentDescription& g : scene.garments)
+            g.pin_weights = o.pin_weights == "skin_surface" ? PinWeights::skin_surface : PinWeights::nearest_vertex;
     if (o.threads) scene.solver.threads = *o.threads;
     if (o.time_scale) scene.solver.time_scale = *o.time_scale;
     return {};
@@ -565,6 +569,9 @@ void add_play_command(CLI::App& app) {
     play_app->add_option("--warp-solve", o->warp_solve,
                          "The shipped solver's warp springs: Gauss-Seidel rounds or each line at once (docs/cloth.md)")
         ->check(one_of({"rounds", "lines"}));
+    play_app->add_option("--pin-weights", o->pin_weights,
+                         "Skinned pins take the nearest skin vertex's weights or the skin's where they sit (docs/cloth.md)")
+        ->check(one_of({"nearest_vertex", "skin_surface"}));
     play_app->add_option("--frames", o->frames, "Frames to play (default 240; in a window: until closed)")
         ->check(integer_in(1, 10'000'000));
     play_app->add_flag("--headless", o->headless, "No rendering at all (no render system)");

@@ -78,6 +78,7 @@ struct GarmentDescription {
     ClothModel model = ClothModel::simplified;
     ClothIntegrator integrator = ClothIntegrator::shipped;  ///< docs/cloth.md "Two integrators".
     WarpSolve warp_solve = WarpSolve::rounds;            ///< docs/cloth.md "Warp lines solved directly".
+    PinWeights pin_weights = PinWeights::nearest_vertex; ///< docs/cloth.md "Pins".
     CollisionMode collision = CollisionMode::candidate_lists;
     std::optional<Vec3> color;                           ///< Linear RGB in [0, 1]; none: the garment's default.
     std::string material;                                ///< A material preset (silk, cotton, denim); empty: cotton.

@@ -481,6 +481,9 @@ GarmentDescription read_garment(const Reader& r, const std::string& path, const 
                                                     {{"shipped", ClothIntegrator::shipped}, {"paper", ClothIntegrator::paper}});
     if (const Json* v = f.get("warp_solve"))
         g.warp_solve = read_choice<WarpSolve>(r, f.path("warp_solve"), *v, {{"rounds", WarpSolve::rounds}, {"lines", WarpSolve::lines}});
+    if (const Json* v = f.get("pin_weights"))
+        g.pin_weights = read_choice<PinWeights>(r, f.path("pin_weights"), *v,
+                                                {{"nearest_vertex", PinWeights::nearest_vertex}, {"skin_surface", PinWeights::skin_surface}});
     if (const Json* v = f.get("collision"))
         g.collision = read_choice<CollisionMode>(r, f.path("collision"), *v,
                                                  {{"lists", CollisionMode::candidate_lists}, {"brute_force", CollisionMode::brute_force}});
@@ -734,6 +737,7 @@ std::string to_json(const SceneDescription& scene) {
         o["model"] = cloth_model_name(g.model);
         if (g.integrator != ClothIntegrator::shipped) o["integrator"] = cloth_integrator_name(g.integrator);
         if (g.warp_solve != WarpSolve::rounds) o["warp_solve"] = "lines";
+        if (g.pin_weights != PinWeights::nearest_vertex) o["pin_weights"] = "skin_surface";
         o["collision"] = collision_mode_name(g.collision);
         if (g.color) o["color"] = vec(*g.color);
         if (!g.material.empty()) o["material"] = g.material;

@@ -59,6 +59,7 @@ Result<TubeParams> tube_params(const GarmentDescription& garment) {
     p.model = garment.model;
     p.integrator = garment.integrator;
     p.collision = garment.collision;
+    p.pin_weights = garment.pin_weights;
     if (garment.color) p.color = *garment.color;
     return p;
 }

@@ -71,6 +71,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
     mp.config.material = params.material;
     mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular};
     mp.config.color = params.color;
+    mp.pin_weights = params.pin_weights;
     auto mesh = import_garment_mesh(g.file, g.mesh);
     if (!mesh) return std::unexpected(mesh.error());
     if (g.pins == PinSource::file && mesh->pin.size() == 0)

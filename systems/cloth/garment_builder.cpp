@@ -15,6 +15,7 @@
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/components/transform.hpp"
 #include "drape/systems/character/body_landmarks.hpp"
+#include "drape/systems/character/trunk_skin.hpp"
 #include "drape/systems/cloth/body.hpp"
 #include "drape/systems/cloth/collision.hpp"
 #include "drape/systems/cloth/garment_parameters.hpp"
@@ -144,7 +145,8 @@ Real hem_leg_half_width(std::span<const EllipsoidFrame> frames, std::span<const 
 
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
-                    std::span<const EllipsoidFrame> frames, std::uint32_t p, const Vec3& x) {
+                    std::span<const EllipsoidFrame> frames, const TrunkSkin* trunk, const MeshAsset& mesh, std::uint32_t p,
+                    const Vec3& x) {
     PinBinding pin;
     pin.particle = p;
     // Nearest collider in unit-sphere terms (the body part the pin sits on).
@@ -166,43 +168,56 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
         Vec4i bones = Vec4i::Zero();
         Vec4 weights = Vec4::Zero();
         bool found = false;
+        if (trunk) {
+            // PinWeights::skin_surface: at the closest point of the trunk's skin, by its
+            // weights there (trunk_skin.hpp), the four strongest.
+            const std::vector<BoneInfluence> influences = trunk_influences(*trunk, mesh, model.cast<double>());
+            double total = 0;
+            for (std::size_t i = 0; i < influences.size() && i < 4; ++i) total += influences[i].weight;
+            for (std::size_t i = 0; i < influences.size() && i < 4 && total > 0; ++i) {
+                bones[static_cast<Eigen::Index>(i)] = influences[i].bone;
+                weights[static_cast<Eigen::Index>(i)] = static_cast<Real>(influences[i].weight / total);
+                found = true;
+            }
+        }
         const auto* skin = registry.try_get<SkinnedMesh>(character);
-        if (skin && skin->mesh && skin->mesh->vertex_count() > 0) {
-            // Weights of the nearest skin vertex, at the current pose (linear blend skinning).
+        if (!trunk && skin && skin->mesh && skin->mesh->vertex_count() > 0) {
+            // PinWeights::nearest_vertex (and a skin without faces): the weights of the nearest
+            // skin vertex at the current pose (linear blend skinning).
             // The fitting zone is on the trunk (method §3.5): on a body with landmarks only
             // skin carried mostly by the pelvis and spine counts, and only those bones' share
             // of its weights, so that a hand hanging at the hip or a thigh does not take the
             // waistband with it.
             const auto* landmarks = registry.try_get<BodyLandmarks>(character);
-            std::vector<bool> trunk;
+            std::vector<bool> on_trunk_bone;
             if (landmarks && landmarks->pelvis_bone >= 0) {
-                trunk.assign(skeleton->skinning.size(), false);
+                on_trunk_bone.assign(skeleton->skinning.size(), false);
                 for (int bone : landmarks->spine)
-                    if (bone >= 0 && static_cast<std::size_t>(bone) < trunk.size()) trunk[static_cast<std::size_t>(bone)] = true;
-                if (static_cast<std::size_t>(landmarks->pelvis_bone) < trunk.size())
-                    trunk[static_cast<std::size_t>(landmarks->pelvis_bone)] = true;
-                if (landmarks->head_bone >= 0 && static_cast<std::size_t>(landmarks->head_bone) < trunk.size())
-                    trunk[static_cast<std::size_t>(landmarks->head_bone)] = false;
+                    if (bone >= 0 && static_cast<std::size_t>(bone) < on_trunk_bone.size()) on_trunk_bone[static_cast<std::size_t>(bone)] = true;
+                if (static_cast<std::size_t>(landmarks->pelvis_bone) < on_trunk_bone.size())
+                    on_trunk_bone[static_cast<std::size_t>(landmarks->pelvis_bone)] = true;
+                if (landmarks->head_bone >= 0 && static_cast<std::size_t>(landmarks->head_bone) < on_trunk_bone.size())
+                    on_trunk_bone[static_cast<std::size_t>(landmarks->head_bone)] = false;
             }
-            const MeshAsset& mesh = *skin->mesh;
+            const MeshAsset& skin_mesh = *skin->mesh;
             Real best_d = std::numeric_limits<Real>::infinity();
-            for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+            for (std::size_t v = 0; v < skin_mesh.vertex_count(); ++v) {
                 const Eigen::Index vi = static_cast<Eigen::Index>(v);
-                const Vec4i b = mesh.bone_indices.col(vi);
-                Vec4 w = mesh.bone_weights.col(vi);
+                const Vec4i b = skin_mesh.bone_indices.col(vi);
+                Vec4 w = skin_mesh.bone_weights.col(vi);
                 bool ok = true;
                 for (int i = 0; i < 4; ++i)
                     if (w[i] != 0 && (b[i] < 0 || static_cast<std::size_t>(b[i]) >= skeleton->skinning.size())) ok = false;
                 if (!ok) continue;
-                if (!trunk.empty()) {
+                if (!on_trunk_bone.empty()) {
                     Vec4 on_trunk = Vec4::Zero();
                     for (int i = 0; i < 4; ++i)
-                        if (w[i] != 0 && trunk[static_cast<std::size_t>(b[i])]) on_trunk[i] = w[i];
+                        if (w[i] != 0 && on_trunk_bone[static_cast<std::size_t>(b[i])]) on_trunk[i] = w[i];
                     const Real share = on_trunk.sum();
                     if (share < Real(0.5) * w.sum()) continue;
                     w = on_trunk / share;
                 }
-                const Vec3 posed = blend_skinning(skeleton->skinning, b, w) * Vec3(mesh.bind_positions.col(vi));
+                const Vec3 posed = blend_skinning(skeleton->skinning, b, w) * Vec3(skin_mesh.bind_positions.col(vi));
                 const Real d = (posed - model).squaredNorm();
                 if (d < best_d) { best_d = d; bones = b; weights = w; found = true; }
             }
@@ -239,16 +254,25 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
 
 // Pins the particles `pinned` marks (grid order, line * m + row), pushes the rest out of
 // the colliders, records the rest shape, and adds the garment to the registry.
-Result<Entity> finish(Registry& registry, Garment g, const std::vector<std::uint8_t>& pinned) {
+Result<Entity> finish(Registry& registry, Garment g, const std::vector<std::uint8_t>& pinned, PinWeights pin_weights) {
     const Fabric& t = *g.fabric;
     GarmentSolver solver;
     GarmentState& state = g.state;
     update_frames(registry, g.body, solver.frames, 1);
+    // PinWeights::skin_surface: the trunk's skin as the character stands, once for every pin.
+    const auto* skin = registry.try_get<SkinnedMesh>(g.body.character);
+    const auto* skeleton = registry.try_get<Skeleton>(g.body.character);
+    const MeshAsset no_mesh;
+    const MeshAsset& mesh = skin && skin->mesh ? *skin->mesh : no_mesh;
+    std::optional<TrunkSkin> trunk;
+    if (pin_weights == PinWeights::skin_surface && skeleton && skeleton->asset && skeleton->skinning.size() == skeleton->asset->size())
+        trunk = trunk_skin(mesh, *skeleton->asset, registry.try_get<BodyLandmarks>(g.body.character), skeleton->skinning);
     for (std::size_t k = 0; k < t.grid.size(); ++k) {
         if (!pinned.at(k)) continue;
         const std::uint32_t p = t.grid[k];
         state.inv_mass[p] = 0;
-        state.pins.push_back(bind_pin(registry, g.body.character, g.body.colliders, solver.frames, p, state.x.col(p)));
+        state.pins.push_back(bind_pin(registry, g.body.character, g.body.colliders, solver.frames, trunk ? &*trunk : nullptr, mesh, p,
+                                      state.x.col(p)));
     }
     for (const PinBinding& pin : state.pins)
         if (auto at = evaluate_pin(registry, g, pin)) state.x.col(pin.particle) = *at;
@@ -452,7 +476,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     std::vector<std::uint8_t> pinned(g.fabric->grid.size(), 0);
     for (int line = 0; line < n; ++line)
         for (int row = 0; row < s.fitting_rows; ++row) pinned[static_cast<std::size_t>(line * m + row)] = 1;
-    return finish(registry, std::move(g), pinned);
+    return finish(registry, std::move(g), pinned, s.pin_weights);
 }
 
 }  // namespace
@@ -692,7 +716,7 @@ Result<Entity> attach_grid_garment(Registry& registry, Entity character, const G
         }
         g.body.colliders.push_back(e);
     }
-    return finish(registry, std::move(g), grid.pinned);
+    return finish(registry, std::move(g), grid.pinned, grid.pin_weights);
 }
 
 Result<Garment> make_rectangle(const RectangleParams& r, std::span<const Entity> colliders) {

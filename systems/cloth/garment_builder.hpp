@@ -14,8 +14,9 @@
 // cone from that outline (plus ease), flaring outward, and is then pushed out of every
 // collider. The top `fitting_rows` rows are pinned (method §3.5):
 //   - skinned to the skin when the character has a Skeleton with skinning matrices
-//     (weights of the nearest skin vertex when it has a SkinnedMesh, else its collider's
-//     bone), so the pins follow linear blend skinning like the body mesh;
+//     (weights of the nearest skin vertex, or with PinWeights::skin_surface the trunk
+//     skin's where the pin sits, when it has a SkinnedMesh, else its collider's bone), so
+//     the pins follow linear blend skinning like the body mesh;
 //   - otherwise bound rigidly to the nearest collider (analytic bodies).
 // Parameter errors name the field ("skirt.length_m: must be in (0, 10] m, got -1"); the
 // ranges are those of the garment parameter table (systems/cloth/garment_parameters.hpp).
@@ -42,6 +43,13 @@ enum class RingPlace : std::uint8_t {
 /// Ring height / body height on a body without landmarks (a non-humanoid, an analytic body).
 [[nodiscard]] Real fallback_ring_height_fraction(RingPlace place) noexcept;
 
+/// Whose weights a skinned pin takes when it is bound (docs/cloth.md "Pins").
+enum class PinWeights : std::uint8_t {
+    nearest_vertex,  ///< The nearest skin vertex's, on the trunk.
+    skin_surface,    ///< The trunk skin's where the pin sits: its face's vertices blended
+                     ///< (systems/character/trunk_skin.hpp); neighbouring pins move together.
+};
+
 /// A skirt or a dress: a tube hung from a ring around the body, flaring into a truncated
 /// cone (see the placement rules above). A skirt and a dress differ only in their values:
 /// the ring is the waist for a skirt and under the arms for a dress. The defaults are the skirt's (`skirt()`); `dress()` gives the dress's. Ranges,
@@ -64,6 +72,7 @@ struct TubeParams {
     int fitting_rows = 1;             ///< Rows pinned to the body (method §3.5).
     Real inertia_linear = 1;          ///< InertiaScales::linear of the garment (1: physical).
     Real inertia_angular = 1;         ///< InertiaScales::angular.
+    PinWeights pin_weights = PinWeights::nearest_vertex;  ///< How the skinned pins are bound.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;
     ClothIntegrator integrator = ClothIntegrator::shipped;
@@ -140,6 +149,7 @@ struct GridGarment {
     Matrix3X grid_positions;           ///< Character model space, grid order (line * m + row).
     std::vector<std::uint8_t> pinned;  ///< Grid order: 1 = held to the skin (method §3.5).
     GarmentConfig config;              ///< Model, integrator, collision, material, inertia, colour.
+    PinWeights pin_weights = PinWeights::nearest_vertex;  ///< How the skinned pins are bound.
 };
 
 /// `grid` on `character`, placed by the character's Transform; pins bound to the skin as the

@@ -13,6 +13,7 @@
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/skinning.hpp"
 #include "drape/systems/character/skin_surface.hpp"
+#include "drape/systems/character/trunk_skin.hpp"
 #include "drape/systems/cloth/garment_surface.hpp"
 #include "drape/components/transform.hpp"
 
@@ -428,6 +429,7 @@ Result<MeshGrid> grid_from_mesh(const GarmentMeshAsset& mesh, const MeshGarmentP
     g.grid_positions = std::move(x);
     g.pinned.assign(static_cast<std::size_t>(n * m), 0);
     g.config = params.config;
+    g.pin_weights = params.pin_weights;
     int held = 0;
     for (int k = 0; k < n * m; ++k) {
         const bool hold = painted ? pin[k] >= Real(0.5) : (k % m) < params.fitting_rows;
@@ -450,50 +452,20 @@ Result<std::string> place_on_current_pose(const Registry& registry, Entity chara
         skeleton->skinning.size() != skeleton->asset->size())
         return fail(std::string(name) + ".modelled_on: the character has no skin and skeleton to place a bind-pose garment by");
     const MeshAsset& body = *skin->mesh;
-    const SkeletonAsset& bones = *skeleton->asset;
-    // The trunk: every bone but the limbs (each chain's first bone and what hangs from it).
-    std::vector<char> trunk(bones.size(), 1);
     const auto* landmarks = registry.try_get<BodyLandmarks>(character);
-    if (landmarks)
-        for (const LimbChain* limb : {&landmarks->left_leg, &landmarks->right_leg, &landmarks->left_arm, &landmarks->right_arm})
-            if (limb->root >= 0 && static_cast<std::size_t>(limb->root) < bones.size()) trunk[static_cast<std::size_t>(limb->root)] = 0;
-    for (std::size_t b = 0; b < bones.size(); ++b)  // parents precede children
-        if (bones.parents[b] >= 0 && !trunk[static_cast<std::size_t>(bones.parents[b])]) trunk[b] = 0;
-    // The skin the trunk moves: triangles whose vertices each hang from it for the most part.
-    const auto trunk_share = [&](std::uint32_t v) {
-        Real share = 0;
-        for (int i = 0; i < 4; ++i) {
-            const int bone = body.bone_indices(i, v);
-            if (bone >= 0 && static_cast<std::size_t>(bone) < bones.size() && trunk[static_cast<std::size_t>(bone)]) share += body.bone_weights(i, v);
-        }
-        return share;
-    };
-    std::vector<std::uint32_t> trunk_triangles;
-    for (std::size_t t = 0; t + 2 < body.indices.size(); t += 3)
-        if (trunk_share(body.indices[t]) >= Real(0.5) && trunk_share(body.indices[t + 1]) >= Real(0.5) && trunk_share(body.indices[t + 2]) >= Real(0.5))
-            trunk_triangles.insert(trunk_triangles.end(), {body.indices[t], body.indices[t + 1], body.indices[t + 2]});
-    if (trunk_triangles.empty())
+    const std::optional<TrunkSkin> bind = trunk_skin(body, *skeleton->asset, landmarks, {});
+    if (!bind)
         return fail(std::string(name) + ".modelled_on: no skin of the character's trunk to place a bind-pose garment by");
-    const SkinSurface bind(body.bind_positions, body.bind_normals, trunk_triangles);
     Real moved = 0;
     for (Eigen::Index v = 0; v < mesh.positions.cols(); ++v) {
         const Eigen::Vector3d p = mesh.positions.col(v).cast<double>();
-        const SkinSurface::Closest c = bind.closest(p);
-        if (c.triangle < 0) continue;
-        const auto& t = bind.triangle(static_cast<std::size_t>(c.triangle));
-        // The influences of the triangle's vertices on the trunk's bones, weighted by the
-        // closest point's barycentric weights, blended and renormalised.
+        // Moved as the closest point of the bind pose's trunk skin is (trunk_skin.hpp).
         Eigen::Matrix<double, 3, 4> blend = Eigen::Matrix<double, 3, 4>::Zero();
         double total = 0;
-        for (int k = 0; k < 3; ++k)
-            for (int i = 0; i < 4; ++i) {
-                const std::uint32_t vertex = t[static_cast<std::size_t>(k)];
-                const int bone = body.bone_indices(i, vertex);
-                const double w = c.weights[k] * double(body.bone_weights(i, vertex));
-                if (w <= 0 || bone < 0 || static_cast<std::size_t>(bone) >= bones.size() || !trunk[static_cast<std::size_t>(bone)]) continue;
-                blend += w * skeleton->skinning[static_cast<std::size_t>(bone)].matrix().topRows<3>().cast<double>();
-                total += w;
-            }
+        for (const BoneInfluence& b : trunk_influences(*bind, body, p)) {
+            blend += b.weight * skeleton->skinning[static_cast<std::size_t>(b.bone)].matrix().topRows<3>().cast<double>();
+            total += b.weight;
+        }
         if (total <= 0) continue;
         const Vec3 placed = (blend / total * p.homogeneous()).cast<Real>();
         moved = std::max(moved, (placed - mesh.positions.col(v)).norm());

@@ -64,6 +64,7 @@ struct MeshGarmentParams {
     int fitting_rows = 1;      ///< Rows held when the pins are automatic.
     GarmentPose modelled_on = GarmentPose::current;
     GarmentConfig config;      ///< Model, integrator, collision, material, inertia, colour.
+    PinWeights pin_weights = PinWeights::nearest_vertex;  ///< How the held particles are bound to the skin.
 };
 
 /// The grid `mesh` gives (see above), in the mesh's space, and one line on how it was made

@@ -53,7 +53,7 @@ constexpr const char* valid_scene = R"({
   "garments": [
     {"type": "skirt", "character": 0, "model": "simplified", "collision": "lists",
      "color": [0.8, 0.1, 0.2], "particles": 837},
-    {"type": "dress", "character": 1, "model": "classic", "integrator": "paper", "collision": "brute_force"}, {"warp_solve": "lines"}
+    {"type": "dress", "character": 1, "model": "classic", "integrator": "paper", "collision": "brute_force"}, {"warp_solve": "lines", "pin_weights": "skin_surface"}
   ],
   "colliders": [
     {"character": 0, "bone": "Hips", "radii_m": [0.2, 0.15, 0.14]},
@@ -88,6 +88,8 @@ TEST_F(SceneFileTest, ValidFileIsReadCompletely) {
     EXPECT_EQ(scene->garments[1].integrator, ClothIntegrator::paper);
     EXPECT_EQ(scene->garments[1].warp_solve, WarpSolve::rounds);
     EXPECT_EQ(scene->garments[2].warp_solve, WarpSolve::lines);
+    EXPECT_EQ(scene->garments[1].pin_weights, PinWeights::nearest_vertex);
+    EXPECT_EQ(scene->garments[2].pin_weights, PinWeights::skin_surface);
     EXPECT_FALSE(scene->garments[1].color.has_value());
     ASSERT_EQ(scene->colliders.size(), 2u);
     EXPECT_TRUE(scene->colliders[1].remove);
@@ -164,6 +166,8 @@ TEST_F(SceneFileTest, WrongTypesAreNamed) {
               "scene.json:1:74: garments[0].integrator: must be one of \"shipped\", \"paper\", got \"implicit\"");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "garments": [{"warp_solve": "direct"}]})"),
               "scene.json:1:74: garments[0].warp_solve: must be one of \"rounds\", \"lines\", got \"direct\"");
+    EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "garments": [{"pin_weights": "nearest"}]})"),
+              "scene.json:1:75: garments[0].pin_weights: must be one of \"nearest_vertex\", \"skin_surface\", got \"nearest\"");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"substeps": 2.5}})"),
               "scene.json:1:69: solver.substeps: must be \"auto\" or an integer in [1, 1000], got 2.5");
     EXPECT_EQ(error(R"({"characters": [{"file": "chars/body.glb"}], "solver": {"max_surface_travel_m": 0}})"),

@@ -127,7 +127,7 @@ TEST_F(SceneGarmentParameters, AMisspeltParameterNameIsAnErrorNamingIt) {
     // On line 2 of the file, at the misspelt key.
     const std::string message = error("skirt", "\"strech_N_m\": 2");
     EXPECT_EQ(message.rfind("scene.json:2:33: garments[0].strech_N_m: unknown field (did you mean \"stretch_N_m\"?); "
-                            "known fields: type, character, model, integrator, warp_solve, collision, color, material, particles, warp_lines,",
+                            "known fields: type, character, model, integrator, warp_solve, pin_weights, collision, color, material, particles, warp_lines,",
                             0),
               0u)
         << message;
