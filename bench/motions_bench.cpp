@@ -229,6 +229,7 @@ nlohmann::json row_json(const RunResult& r) {
     j["strain_max"] = r.stats.strain_max;
     j["strain_p99"] = r.stats.strain_p99;
     j["compression_min"] = r.stats.compression_min;
+    j["pinned_strain_max"] = r.stats.pinned_strain_max;
     j["penetration_after_m"] = r.stats.penetration_after_frame_m;
     j["skin_penetration_max_m"] = r.stats.skin_penetration_max_m;
     j["skin_penetration_p99_m"] = r.stats.skin_penetration_p99_m;

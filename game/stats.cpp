@@ -39,6 +39,7 @@ void GarmentWatch::sample(const Registry& registry) {
         m_latest_strain_p99 = std::max(m_latest_strain_p99, double(q.strain_p99));
         GarmentStats& w = t.worst;
         worse(w.strain_max, q.strain_max);
+        worse(w.pinned_strain_max, q.pinned_strain_max);
         worse(w.penetration_after_frame_m, q.penetration_m);
         worse(w.within_give_m, q.within_give_m);
         worse(w.pins_inside_m, q.pins_inside_m);
@@ -120,7 +121,7 @@ std::string stats_json(const RunStats& stats) {
     Json garments = Json::array();
     for (const GarmentStats& g : stats.garments)
         garments.push_back({{"particles", g.particles},
-                            {"strain", {{"max", number(g.strain_max)}, {"p99", number(g.strain_p99)}}},
+                            {"strain", {{"max", number(g.strain_max)}, {"p99", number(g.strain_p99)}, {"pinned_max", number(g.pinned_strain_max)}}},
                             {"compression_min", number(g.compression_min)},
                             {"penetration_m",
                              {{"after_frame_max", number(g.penetration_after_frame_m)},

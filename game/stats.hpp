@@ -43,6 +43,7 @@ struct GarmentStats {
     double strain_max = 0;               ///< Largest strain of a structural spring with a free end after a frame.
     double strain_p99 = 0;               ///< 99th percentile of those strains over every frame.
     double compression_min = 1;          ///< Shortest such spring over its rest length after a frame, over the run.
+    double pinned_strain_max = 0;        ///< Largest strain of a spring between two pinned particles after a frame (the fitting zone as the skin carries it; not in strain_max).
     double penetration_after_frame_m = 0;///< Deepest free particle inside an ellipsoid after a frame (past its give).
     double within_give_m = 0;            ///< Deepest free particle inside a giving ellipsoid, within its give, after a frame.
     double penetration_before_response_m = 0; ///< Deepest penetration the collision found before moving a particle out.

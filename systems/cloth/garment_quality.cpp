@@ -66,8 +66,11 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
     for (const SpringPhase* phase : {&t.warp1, &t.warp2, &t.weft})
         for (std::size_t s = 0; s < phase->size(); ++s) {
             const std::uint32_t a = phase->a[s], b = phase->b[s];
-            if (w[a] == 0 && w[b] == 0) continue;
             const Real ratio = (x.col(b) - x.col(a)).norm() / phase->rest_m[s];
+            if (w[a] == 0 && w[b] == 0) {
+                q.pinned_strain_max = std::max(q.pinned_strain_max, std::isfinite(ratio) ? ratio - 1 : std::numeric_limits<Real>::infinity());
+                continue;
+            }
             if (std::isfinite(ratio)) q.compression_min = std::min(q.compression_min, ratio);
             const Real strain = std::isfinite(ratio) ? std::max(Real(0), ratio - 1) : std::numeric_limits<Real>::infinity();
             strains.push_back(strain);

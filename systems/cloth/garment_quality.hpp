@@ -6,7 +6,9 @@
 // - Strain of a spring: length / rest - 1 (compression counts as 0), over every structural
 //   spring (warp of both layers, weft) with at least one free end: between two pinned
 //   particles the skin decides. Compression is reported apart: the shortest of those springs
-//   over its rest length.
+//   over its rest length; so is the pinned rows' own strain, of the springs between two
+//   pinned particles, which the skinning of the pins and their push-out give (a fitting zone
+//   the skin tears is seen, though the cloth cannot mend it).
 // - Depth inside an ellipsoid: how far the centre-line response would move the particle out
 //   (collision.hpp penetration_depth), an upper bound of its distance to the surface; for an
 //   ellipsoid that gives (EllipsoidCollider::give_m), the depth past what its give allows
@@ -41,6 +43,7 @@ struct GarmentQuality {
     Real strain_max = 0;            ///< Largest strain of a spring with a free end.
     Real strain_p99 = 0;            ///< Its 99th percentile over those springs.
     Real compression_min = 1;       ///< Shortest of those springs over its rest length (1: none shorter than rest).
+    Real pinned_strain_max = 0;     ///< Largest strain of a spring between two pinned particles (not in strain_max).
     Real penetration_m = 0;         ///< Deepest free particle inside an ellipsoid (past its give).
     Real within_give_m = 0;         ///< Deepest free particle inside an ellipsoid within its give.
     Real pins_inside_m = 0;         ///< Deepest pinned particle inside an ellipsoid.

@@ -17,6 +17,7 @@
 #include "drape/systems/cloth/constraints.hpp"
 #include "drape/systems/cloth/garment_builder.hpp"
 #include "drape/systems/cloth/garment_config.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 #include "drape/systems/cloth/garment_step.hpp"
 #include "drape/systems/cloth/pins.hpp"
 
@@ -317,6 +318,27 @@ TEST(Pins, AWaistbandStretchesNoMoreThanTheSkinUnderItWhereTheWeightsChangeFast)
     }
     ASSERT_GT(pinned_springs, 0);
     EXPECT_LE(worst, skin_most) << "the pinned row stretched more than the skin under it";
+}
+
+// The pinned rows' own strain is measured apart from the free cloth's: a pin carried half a
+// weft spring's rest length away from its neighbour on the ring shows in pinned_strain_max.
+TEST(Pins, ThePinnedRowsOwnStrainIsMeasuredApart) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, TubeParams::skirt());
+    scene.run(1);
+    Garment& g = scene.registry.get<Garment>(e);
+    const GarmentQuality before = measure_garment(scene.registry, g);
+    EXPECT_LT(before.pinned_strain_max, Real(0.01));
+    // Two pins that are neighbours on the weft (the top row).
+    const SpringPhase& weft = g.fabric->weft;
+    std::size_t k = 0;
+    while (k < weft.size() && !(g.state.inv_mass[weft.a[k]] == 0 && g.state.inv_mass[weft.b[k]] == 0)) ++k;
+    ASSERT_LT(k, weft.size());
+    const Vec3 along = (g.state.x.col(weft.b[k]) - g.state.x.col(weft.a[k])).normalized();
+    g.state.x.col(weft.b[k]) += Real(0.5) * weft.rest_m[k] * along;
+    const GarmentQuality after = measure_garment(scene.registry, g);
+    EXPECT_GT(after.pinned_strain_max, Real(0.4));
+    EXPECT_LT(after.pinned_strain_max, Real(0.6));
 }
 
 TEST(Substeps, RuleFollowsStabilityAndColliderSpeed) {

@@ -45,6 +45,7 @@ RunStats example() {
                           .within_give_m = 0.02, .penetration_before_response_m = 0.004, .pins_inside_m = 0.002, .below_ground_m = 0.003, .rise_above_pins_m = 0.01,
                           .nonfinite = 0, .resets = 1, .collision_tests_per_frame = 1234.5});
     r.garments.back().compression_min = 0.8;
+    r.garments.back().pinned_strain_max = 0.3;
     r.garments.back().repair_rounds_max = 7;
     r.garments.back().budget_hits = 3;
     r.garments.back().skin_measured = true;
@@ -80,7 +81,8 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     EXPECT_DOUBLE_EQ(g["compression_min"].get<double>(), 0.8);
     EXPECT_EQ(g["repair_rounds_max"], 7);
     EXPECT_EQ(g["budget_hits"], 3);
-    EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99"}));
+    EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99", "pinned_max"}));
+    EXPECT_DOUBLE_EQ(g["strain"]["pinned_max"].get<double>(), 0.3);
     EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max", "below_ground_max", "within_give_max"}));
     EXPECT_DOUBLE_EQ(g["strain"]["p99"].get<double>(), 0.05);
     EXPECT_DOUBLE_EQ(g["penetration_m"]["before_response_max"].get<double>(), 0.004);
