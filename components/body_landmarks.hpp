@@ -54,11 +54,13 @@ struct BodyLandmarks {
 
     Real crotch_m = 0;             ///< Lowest height where the pelvis's skin crosses the midplane.
     Real underarm_m = 0;           ///< Mean height of the armpits.
-    BodyPoint under_arms;          ///< The waist's centre raised to the underarm height.
+    /// The waist's centre raised to where the arms' skin (by its weights) reaches lowest on
+    /// the trunk: at or under the armpits; the built-in dress is held just under it.
+    BodyPoint arms_meet_trunk;
     BodySection waist;             ///< Narrowest torso section between crotch and underarm.
-    BodySection hips;              ///< Widest section (torso and thighs) between crotch and waist.
-    BodySection chest;             ///< Widest torso section between waist and underarm.
-    BodyPoint left_shoulder, right_shoulder;  ///< Shoulder joints.
+    BodySection hips;              ///< Widest trunk section between crotch and waist.
+    BodySection chest;             ///< Trunk section reaching farthest forward between waist and underarm.
+    BodyPoint left_shoulder, right_shoulder;  ///< The upper arms' heads.
     std::string found_by;          ///< "bone names" or "topology": how the pelvis was found.
     /// How each landmark was found, in the order `drape inspect` prints them: {landmark, how}.
     std::vector<std::pair<std::string, std::string>> how_found;

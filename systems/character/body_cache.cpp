@@ -183,7 +183,7 @@ void body_fields(Io& io, Body& body) {
         io.items(l.body_bones, sizeof(int), [&](auto& bone) { io.raw(bone); });
         io.raw(l.crotch_m);
         io.raw(l.underarm_m);
-        point(io, l.under_arms);
+        point(io, l.arms_meet_trunk);
         section(io, l.waist);
         section(io, l.hips);
         section(io, l.chest);

@@ -2,6 +2,7 @@
 #include "drape/systems/character/body_landmarks.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -146,6 +147,71 @@ Cut section(const Rig& rig, const std::vector<std::uint32_t>& indices, const std
     cut.half_depth = Real(0.5 * (hi.y() - lo.y()));
     cut.valid = true;
     return cut;
+}
+
+// Distance between two segments of the plane.
+double segment_distance(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d) {
+    const auto cross = [](const Vec2d& p, const Vec2d& q) { return p.x() * q.y() - p.y() * q.x(); };
+    if (cross(b - a, c - a) * cross(b - a, d - a) < 0 && cross(d - c, a - c) * cross(d - c, b - c) < 0) return 0;
+    const auto to_segment = [](const Vec2d& p, const Vec2d& s0, const Vec2d& s1) {
+        const Vec2d e = s1 - s0;
+        const double t = e.squaredNorm() > 0 ? std::clamp((p - s0).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+        return (s0 + t * e - p).norm();
+    };
+    return std::min({to_segment(a, c, d), to_segment(b, c, d), to_segment(c, a, b), to_segment(d, a, b)});
+}
+
+// The skin's section at height `y` on one side of the body (`sign` along `left` from
+// `origin`), as segments in the (across, forward) plane, joined into pieces where they come
+// within `gap` of each other: whether a piece lies beyond the one over the body's middle (an
+// arm hanging apart from the trunk), and how far the middle piece reaches (along `left`
+// times `sign`, from `origin`).
+struct SideGap {
+    bool gap = false;
+    Real trunk_end = 0;
+};
+SideGap side_gap(const Rig& rig, const std::vector<std::uint32_t>& indices, Real y, const Vec3& left, const Vec3& forward,
+                 const Vec3& origin, Real sign, Real gap) {
+    std::vector<std::array<Vec2d, 2>> segments;
+    for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+        std::array<Vec2d, 2> s;
+        int found = 0;
+        for (int e = 0; e < 3 && found < 2; ++e) {
+            const Vec3 a = rig.positions.col(indices[t + static_cast<std::size_t>(e)]);
+            const Vec3 b = rig.positions.col(indices[t + static_cast<std::size_t>((e + 1) % 3)]);
+            if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
+            const Vec3 q = a + (b - a) * ((y - a.y()) / (b.y() - a.y())) - origin;
+            s[static_cast<std::size_t>(found++)] = Vec2d(double(sign * q.dot(left)), double(q.dot(forward)));
+        }
+        if (found == 2 && std::max(s[0].x(), s[1].x()) >= 0) segments.push_back(s);
+    }
+    SideGap out;
+    const std::size_t k = segments.size();
+    if (k == 0) return out;
+    std::vector<std::size_t> parent(k);
+    for (std::size_t i = 0; i < k; ++i) parent[i] = i;
+    const auto root = [&](std::size_t i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    for (std::size_t i = 0; i < k; ++i)
+        for (std::size_t j = i + 1; j < k; ++j)
+            if (root(i) != root(j) && segment_distance(segments[i][0], segments[i][1], segments[j][0], segments[j][1]) <= double(gap))
+                parent[root(i)] = root(j);
+    // The middle piece: the one reaching nearest the middle of the body.
+    std::size_t middle = 0;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < k; ++i) {
+        const double u = std::min(segments[i][0].x(), segments[i][1].x());
+        if (u < nearest) nearest = u, middle = root(i);
+    }
+    double end = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < k; ++i)
+        if (root(i) == middle) end = std::max({end, segments[i][0].x(), segments[i][1].x()});
+    for (std::size_t i = 0; i < k && !out.gap; ++i)
+        out.gap = root(i) != middle && std::max(segments[i][0].x(), segments[i][1].x()) > end;
+    out.trunk_end = Real(end);
+    return out;
 }
 
 BodyPoint body_point(const Rig& rig, int bone, const Vec3& rest) {
@@ -360,8 +426,36 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
     }
     out.crotch_m = crotch;
 
-    // Armpits: the lowest arm skin on a triangle shared with the trunk.
+    // Armpits, from the skin's shape: scanning down from the shoulder, the first height at
+    // which the skin's section across the body parts into the trunk and an arm hanging
+    // beside it (the gap opens under the armpit), refined to a millimetre. Else (an arm held
+    // out, or touching the trunk all the way down) the lowest arm skin on a triangle shared
+    // with the trunk.
     const std::vector<std::uint32_t>& indices = mesh.indices;
+    std::array<Real, 2> gap_armpit{std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::quiet_NaN()};
+    std::array<Real, 2> gap_side{0, 0};
+    for (int s = 0; s < 2; ++s) {
+        const LimbChain& chain = s == 0 ? out.left_arm : out.right_arm;
+        const Real sign = s == 0 ? Real(1) : Real(-1);
+        Real top = joint(rig, chain.root).y();
+        if (chain.middle >= 0) top = std::max(top, joint(rig, chain.middle).y());
+        const Real step = Real(0.0025) * h, gap = Real(0.001) * h, bottom = crotch + Real(0.1) * h;
+        for (Real y = top; y > bottom; y -= step) {
+            SideGap g = side_gap(rig, indices, y, out.left, out.forward, axis, sign, gap);
+            if (!g.gap) continue;
+            Real joined = y + step;  // refine between the parted height and the one above it
+            for (int i = 0; i < 8 && joined - y > Real(0.0005) * h; ++i) {
+                const Real mid = Real(0.5) * (y + joined);
+                const SideGap m = side_gap(rig, indices, mid, out.left, out.forward, axis, sign, gap);
+                if (m.gap) y = mid, g = m;
+                else joined = mid;
+            }
+            gap_armpit[static_cast<std::size_t>(s)] = Real(0.5) * (y + joined);
+            gap_side[static_cast<std::size_t>(s)] = axis.dot(out.left) + sign * g.trunk_end;
+            break;
+        }
+    }
+    const bool armpits_by_shape = std::isfinite(gap_armpit[0]) && std::isfinite(gap_armpit[1]);
     std::array<Real, 2> armpit{std::numeric_limits<Real>::infinity(), std::numeric_limits<Real>::infinity()};
     std::array<Real, 2> armpit_side{0, 0};  // along `left`: where each armpit is across the body
     for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
@@ -386,9 +480,34 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         if (!std::isfinite(a) || a > shoulder || a < shoulder - Real(0.15) * h) a = shoulder - Real(0.06) * h;
         else ++armpits_on_skin;
     }
+    // Where the arms' skin reaches lowest on the trunk: the waist is looked for below it,
+    // and the built-in dress is held under it (arms_meet_trunk).
+    const Real arms_skin = Real(0.5) * (armpit[0] + armpit[1]);
+    if (armpits_by_shape) {
+        armpit = gap_armpit;
+        armpit_side = gap_side;
+        armpits_on_skin = 2;
+    }
     out.underarm_m = Real(0.5) * (armpit[0] + armpit[1]);
-    out.left_shoulder = body_point(rig, out.left_arm.root, joint(rig, out.left_arm.root));
-    out.right_shoulder = body_point(rig, out.right_arm.root, joint(rig, out.right_arm.root));
+    // Shoulders: the upper arm's head, the first joint of the arm's chain (from the trunk
+    // out) above its armpit and as far out as the trunk's side there (a clavicle's joint by
+    // the neck is not); else the chain's first joint.
+    for (int s = 0; s < 2; ++s) {
+        const LimbChain& chain = s == 0 ? out.left_arm : out.right_arm;
+        const Real sign = s == 0 ? Real(1) : Real(-1);
+        int head = chain.root;
+        if (armpits_by_shape)
+            for (int b : {chain.root, chain.middle, chain.end}) {
+                if (b < 0) continue;
+                const Vec3 j = joint(rig, b);
+                if (j.y() > armpit[static_cast<std::size_t>(s)] &&
+                    sign * (j.dot(out.left) - armpit_side[static_cast<std::size_t>(s)]) >= -Real(0.01) * h) {
+                    head = b;
+                    break;
+                }
+            }
+        (s == 0 ? out.left_shoulder : out.right_shoulder) = body_point(rig, head, joint(rig, head));
+    }
     if (!(out.underarm_m > crotch + Real(0.1) * h))
         return fail(at + "the armpits are not above the crotch by a tenth of the height");
 
@@ -412,10 +531,10 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         }
         return best;
     };
-    const Real span = out.underarm_m - crotch;
+    const Real span = arms_skin - crotch;
     const Cut waist = extreme(trunk_and_thighs, crotch + Real(0.3) * span, crotch + Real(0.8) * span, true);
     if (!waist.valid) return fail(at + "the trunk's skin has no section between crotch and armpits");
-    const Cut hips = extreme(trunk_and_thighs, crotch, waist.center.y(), false);
+    const Cut hips = extreme(trunk, crotch, waist.center.y(), false);
     // The chest: the trunk, and the skin of the arms' first bones (a clavicle's, over the
     // upper chest) between the armpits, where it is chest, not arm.
     Cut chest;
@@ -424,18 +543,23 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         for (const LimbChain* a : {&out.left_arm, &out.right_arm}) chest_bones[static_cast<std::size_t>(a->root)] = 1;
         const bool sides = armpits_on_skin == 2 && armpit_side[0] > armpit_side[1];
         constexpr int samples = 24;
+        std::vector<Cut> cuts;
         for (int i = 0; i <= samples; ++i) {
             const Real y = waist.center.y() + (out.underarm_m - waist.center.y()) * Real(i) / samples;
             const Cut c = sides ? section(rig, indices, chest_bones, y, out.left, out.forward, armpit_side[1], armpit_side[0])
                                 : section(rig, indices, trunk, y, out.left, out.forward);
-            if (c.valid && (!chest.valid || c.girth > chest.girth)) chest = c;
+            if (c.valid) cuts.push_back(c);
         }
+        // The bust or the pectorals: the section whose front reaches farthest forward.
+        const auto front = [&](const Cut& k) { return k.center.dot(out.forward) + k.half_depth; };
+        for (const Cut& c : cuts)
+            if (!chest.valid || front(c) > front(chest)) chest = c;
     }
     out.waist = make_section(waist);
     out.hips = make_section(hips.valid ? hips : waist);
     out.chest = make_section(chest.valid ? chest : waist);
-    const Vec3 under(waist.center.x(), out.underarm_m, waist.center.z());
-    out.under_arms = body_point(rig, spine_bone_at(rig, out.spine, out.underarm_m), under);
+    const Vec3 meet(waist.center.x(), arms_skin, waist.center.z());
+    out.arms_meet_trunk = body_point(rig, spine_bone_at(rig, out.spine, arms_skin), meet);
 
     const std::string pelvis_name = "'" + skeleton.bone_names[static_cast<std::size_t>(pelvis)] + "'";
     const std::string chest_name = "'" + skeleton.bone_names[static_cast<std::size_t>(out.chest_bone)] + "'";
@@ -445,15 +569,17 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         {"crotch", crotch_parted   ? "where the legs part: the lowest skin on the midplane between the thighs, above the knees"
                    : crotch_on_skin ? "the lowest skin of the pelvis bone at the midplane (the legs do not part above the knees)"
                                     : "5 % of the height under the pelvis joint (the legs do not part, no pelvis skin at the midplane)"},
-        {"hips", hips.valid ? "the widest section of trunk and thighs between crotch and waist" : "the waist's (no section below it)"},
-        {"waist", "the narrowest trunk section 30-80 % of the way from crotch to armpits"},
+        {"hips", hips.valid ? "the widest section of the trunk's skin between crotch and waist" : "the waist's (no section below it)"},
+        {"waist", "the narrowest trunk section 30-80 % of the way from the crotch to where the arms' skin weights meet the trunk"},
         {"chest", !chest.valid ? "the waist's (no section above it)"
-                  : armpits_on_skin == 2 ? "the fullest section of the trunk (and the arms' first bones between the armpits) between waist and armpits"
-                                         : "the fullest trunk section between waist and armpits"},
-        {"under the arms", armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk, both sides"
+                  : armpits_on_skin == 2 ? "the section of the trunk (and the arms' first bones between the armpits) reaching farthest forward between waist and armpits"
+                                         : "the trunk section reaching farthest forward between waist and armpits"},
+        {"under the arms", armpits_by_shape ? "where the skin's section across the body parts into trunk and arm, scanning down from the shoulders, both sides"
+                           : armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk, both sides"
                            : armpits_on_skin == 1 ? "one side's lowest arm skin shared with the trunk; the other 6 % of the height under its shoulder joint"
                                                   : "6 % of the height under the shoulder joints (arms and trunk are separate pieces)"},
-        {"shoulders", "the joints of the two chains reaching farthest sideways from spine bone " + chest_name},
+        {"shoulders", (armpits_by_shape ? "the joints nearest the armpits above them, of the two chains reaching farthest sideways from spine bone "
+                                         : "the joints of the two chains reaching farthest sideways from spine bone ") + chest_name},
     };
     return out;
 }

@@ -20,12 +20,18 @@
 //    thighs' joints cuts the skin, within 15 % of the height in front of or behind them and
 //    above the knees; else the lowest skin point of the pelvis bone within 2 % of the height
 //    of the midplane.
-//  - armpit: the lowest skin point of an arm chain on a triangle it shares with the trunk;
-//    where the two are separate pieces (a robot), the shoulder joint less 6 % of the
-//    height. underarm = the mean of the two.
+//  - armpit: scanning down from the shoulder, the first height at which the skin's section
+//    on that side parts into the trunk's piece and an arm's beyond it (pieces within 0.1 %
+//    of the height joined); else the lowest skin point of an arm chain on a triangle it
+//    shares with the trunk; where the two are separate pieces (a robot), the shoulder joint
+//    less 6 % of the height. underarm = the mean of the two.
+//  - arms_meet_trunk: the lowest arm skin on a triangle shared with the trunk (by weight),
+//    at or under the armpits; the built-in dress is held under it.
 //  - waist: the narrowest trunk section between 30 % and 80 % of the way from crotch to
-//    underarm; hips: the widest section of trunk and thighs between crotch and waist;
-//    chest: the widest trunk section between waist and underarm.
+//    arms_meet_trunk; hips: the widest trunk section between crotch and waist; chest: the
+//    section reaching farthest forward between waist and underarm.
+//  - shoulders: the first arm chain joint above the armpit and as far out as the trunk's
+//    side (the upper arm's head).
 #pragma once
 
 #include "drape/components/body_landmarks.hpp"

@@ -331,7 +331,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     const auto* pose = registry.try_get<Skeleton>(character);
     const auto* transform = registry.try_get<Transform>(character);
     if (landmarks && pose && transform && !pose->global.empty()) {
-        const BodyPoint& at = s.ring_at == RingPlace::waist ? landmarks->waist.center : landmarks->under_arms;
+        const BodyPoint& at = s.ring_at == RingPlace::waist ? landmarks->waist.center : landmarks->arms_meet_trunk;
         const Vec3 ring = landmark_world(at, *pose, *transform);
         height = landmarks->height_m * transform->scale;
         bottom = (transform->matrix() * Vec3(0, landmarks->floor_m, 0)).y();  // an upright character
@@ -695,7 +695,7 @@ Result<Entity> attach_grid_garment(Registry& registry, Entity character, const G
     const auto* pose = registry.try_get<Skeleton>(character);
     if (landmarks && pose && transform && !pose->global.empty()) {
         const Real waist = landmark_world(landmarks->waist.center, *pose, *transform).y();
-        const Real arms = landmark_world(landmarks->under_arms, *pose, *transform).y();
+        const Real arms = landmark_world(landmarks->arms_meet_trunk, *pose, *transform).y();
         const Real shoulders = Real(0.5) * (landmark_world(landmarks->left_shoulder, *pose, *transform).y() +
                                             landmark_world(landmarks->right_shoulder, *pose, *transform).y());
         arms_outside = held.y() > Real(0.5) * (waist + arms) && held.y() < Real(0.5) * (arms + shoulders);

@@ -37,7 +37,7 @@ namespace drape {
 /// Where a tube's ring sits on a body with landmarks (components/body_landmarks.hpp).
 enum class RingPlace : std::uint8_t {
     waist,       ///< BodyLandmarks::waist: a skirt.
-    under_arms,  ///< Just under the armpits (BodyLandmarks::under_arms): a strapless dress.
+    under_arms,  ///< Just under where the arms' skin meets the trunk (BodyLandmarks::arms_meet_trunk): a strapless dress.
 };
 
 /// Ring height / body height on a body without landmarks (a non-humanoid, an analytic body).

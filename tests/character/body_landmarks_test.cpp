@@ -3,10 +3,13 @@
 // legs hang from another bone than the one named Hips) and a non-humanoid.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "drape/engine/assets/character_import.hpp"
@@ -85,41 +88,63 @@ TEST(BodyLandmarks, SharedHumanoidsByTopology) {
     }
 }
 
-// Where the legs part and where a skirt is held, marked by eye once on each character's
-// rest pose (front and side orthographic renders with a ruler every 5 cm; docs/characters.md,
-// "Landmarks marked by eye", has every landmark's mark): the crotch and the waist within 3 cm.
-// On the Alien, whose crotch is a flat underside, the crotch is marked between its front edge
-// and its lowest point. RobotExpressive's bell-shaped trunk has no narrowing to mark as a
-// waist. The crotch rule it replaced, the lowest skin of the pelvis bone, fell back to under
-// the pelvis joint 10-13 cm low on the four human characters, whose skin there follows the
-// thighs.
-TEST(BodyLandmarks, TheCrotchAndTheWaistAreWhereMarkedByEye) {
+// Every landmark, marked by eye once on each character's rest pose (front and side
+// orthographic renders with a ruler every 5 cm; docs/characters.md, "Landmarks marked by
+// eye"), within 3 cm of the mark. On the Alien, whose crotch is a flat underside, the crotch
+// is marked between its front edge and its lowest point. RobotExpressive's bell-shaped trunk
+// has no narrowing to mark as a waist and no chest. Four marks are missed and listed here
+// with where they are found (docs/characters.md says why): they are asserted to be still
+// off, so that the list goes when the rule finds them. The lowest skin of the pelvis bone
+// put the crotch 10-13 cm low on the four human characters, whose skin there follows the
+// thighs; the armpits read from the skin weights were 5-11 cm low on all seven shared
+// characters, and the arm chains' first joints (the clavicles) 6-10 cm under the shoulders.
+TEST(BodyLandmarks, EveryLandmarkIsWhereMarkedByEye) {
+    const Real none = std::numeric_limits<Real>::quiet_NaN();
     struct Mark {
         fs::path file;
-        Real crotch_m;
-        Real waist_m;  // NaN: none marked
+        Real crotch, hips, waist, chest, underarm, shoulders;
     };
-    const Real none = std::numeric_limits<Real>::quiet_NaN();
     const fs::path shared = test::shared_assets();
     const std::vector<Mark> marks = {
-        {test::source_dir() / "assets/avatar.glb", Real(0.79), Real(1.09)},
-        {shared / "characters/male_casual/Male_Casual.fbx", Real(0.80), Real(1.10)},
-        {shared / "characters/female_alternative/Female_Alternative.fbx", Real(0.80), Real(1.13)},
-        {shared / "characters/female_tanktop/Female_TankTop.fbx", Real(0.79), Real(1.11)},
-        {shared / "characters/male_longsleeve/Male_LongSleeve.fbx", Real(0.80), Real(1.10)},
-        {shared / "characters/goblin/Goblin.fbx", Real(0.57), Real(0.75)},
-        {shared / "characters/alien/Alien.fbx", Real(0.36), Real(0.68)},
-        {shared / "characters/robot_expressive/RobotExpressive.glb", Real(0.54), none},
+        {test::source_dir() / "assets/avatar.glb", 0.79f, 0.93f, 1.09f, 1.30f, 1.27f, 1.40f},
+        {shared / "characters/male_casual/Male_Casual.fbx", 0.80f, 0.93f, 1.10f, 1.28f, 1.32f, 1.38f},
+        {shared / "characters/female_alternative/Female_Alternative.fbx", 0.80f, 0.92f, 1.13f, 1.28f, 1.31f, 1.38f},
+        {shared / "characters/female_tanktop/Female_TankTop.fbx", 0.79f, 0.91f, 1.11f, 1.26f, 1.31f, 1.37f},
+        {shared / "characters/male_longsleeve/Male_LongSleeve.fbx", 0.80f, 0.90f, 1.10f, 1.29f, 1.32f, 1.38f},
+        {shared / "characters/goblin/Goblin.fbx", 0.57f, 0.72f, 0.75f, 1.08f, 1.11f, 1.20f},
+        {shared / "characters/alien/Alien.fbx", 0.36f, 0.42f, 0.68f, 0.82f, 0.85f, 0.92f},
+        {shared / "characters/robot_expressive/RobotExpressive.glb", 0.54f, 0.59f, none, none, 0.89f, 0.93f},
+    };
+    // Missed: {file name, landmark}.
+    const std::vector<std::pair<std::string, std::string>> missed = {
+        {"Alien.fbx", "hips"},             // 0.614 m: its trunk's fullest section is its belly; the skin below is the thighs'
+        {"Male_LongSleeve.fbx", "chest"},  // 1.15 m: the shirt's front is flat to 2 mm from waist to armpits
+        {"Male_Casual.fbx", "under the arms"},      // 1.27 m: one arm is modelled pressed against the trunk
+        {"Male_LongSleeve.fbx", "under the arms"},  // 1.27 m: the same, down to 1.24 m on one side
     };
     for (const Mark& mark : marks) {
-        SCOPED_TRACE(mark.file.filename().string());
+        const std::string name = mark.file.filename().string();
+        SCOPED_TRACE(name);
         DRAPE_REQUIRE_SHARED(mark.file);
         const auto c = load(mark.file);
         ASSERT_TRUE(c);
         const auto l = find_body_landmarks(*c);
         ASSERT_TRUE(l) << l.error().message;
-        EXPECT_NEAR(l->crotch_m, mark.crotch_m, Real(0.03));
-        if (!std::isnan(mark.waist_m)) EXPECT_NEAR(l->waist.center.rest_m.y(), mark.waist_m, Real(0.03));
+        const std::vector<std::pair<std::string, std::pair<Real, Real>>> found = {
+            {"crotch", {l->crotch_m, mark.crotch}},
+            {"hips", {l->hips.center.rest_m.y(), mark.hips}},
+            {"waist", {l->waist.center.rest_m.y(), mark.waist}},
+            {"chest", {l->chest.center.rest_m.y(), mark.chest}},
+            {"under the arms", {l->underarm_m, mark.underarm}},
+            {"shoulders", {Real(0.5) * (l->left_shoulder.rest_m.y() + l->right_shoulder.rest_m.y()), mark.shoulders}},
+        };
+        for (const auto& [landmark, heights] : found) {
+            if (std::isnan(heights.second)) continue;
+            const bool is_missed = std::find(missed.begin(), missed.end(), std::pair{name, landmark}) != missed.end();
+            const Real off = std::abs(heights.first - heights.second);
+            if (is_missed) EXPECT_GT(off, Real(0.03)) << landmark << " found within 3 cm of the mark now: take it off the list";
+            else EXPECT_LE(off, Real(0.03)) << landmark << " at " << heights.first << " m, marked at " << heights.second << " m";
+        }
     }
 }
 

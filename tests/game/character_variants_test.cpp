@@ -208,7 +208,7 @@ void expect_same_landmarks(const BodyLandmarks& a, const BodyLandmarks& b) {
     EXPECT_LT((a.waist.center.rest_m - b.waist.center.rest_m).norm(), within);
     EXPECT_LT((a.hips.center.rest_m - b.hips.center.rest_m).norm(), within);
     EXPECT_LT((a.chest.center.rest_m - b.chest.center.rest_m).norm(), within);
-    EXPECT_LT((a.under_arms.rest_m - b.under_arms.rest_m).norm(), within);
+    EXPECT_LT((a.arms_meet_trunk.rest_m - b.arms_meet_trunk.rest_m).norm(), within);
     EXPECT_LT((a.left_shoulder.rest_m - b.left_shoulder.rest_m).norm(), within);
     EXPECT_LT((a.right_shoulder.rest_m - b.right_shoulder.rest_m).norm(), within);
     EXPECT_NEAR(a.waist.girth_m, b.waist.girth_m, 2 * within);
