@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "drape/engine/assets/skinning.hpp"
@@ -107,6 +108,12 @@ std::vector<Vec2d> convex_hull(std::vector<Vec2d> p) {
     return h;
 }
 
+// Where the edge a-b crosses the horizontal plane at height `y`, if it does.
+std::optional<Vec3> crossing(const Vec3& a, const Vec3& b, Real y) {
+    if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) return std::nullopt;
+    return a + ((y - a.y()) / (b.y() - a.y())) * (b - a);
+}
+
 struct Cut {
     bool valid = false;
     Vec3 center = Vec3::Zero();
@@ -124,10 +131,9 @@ Cut section(const Rig& rig, const std::vector<std::uint32_t>& indices, const std
         for (std::uint32_t i : v) ours = ours && bones[static_cast<std::size_t>(rig.owner[i])];
         if (!ours) continue;
         for (int e = 0; e < 3; ++e) {
-            const Vec3 a = rig.positions.col(v[e]), b = rig.positions.col(v[(e + 1) % 3]);
-            if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
-            const Real s = (y - a.y()) / (b.y() - a.y());
-            const Vec3 p = a + s * (b - a);
+            const std::optional<Vec3> at = crossing(rig.positions.col(v[e]), rig.positions.col(v[(e + 1) % 3]), y);
+            if (!at) continue;
+            const Vec3& p = *at;
             if (p.dot(left) < left_min || p.dot(left) > left_max) continue;  // beyond the armpits: an arm
             points.emplace_back(double(p.dot(left)), double(p.dot(forward)));
         }
@@ -177,10 +183,10 @@ SideGap side_gap(const Rig& rig, const std::vector<std::uint32_t>& indices, Real
         std::array<Vec2d, 2> s;
         int found = 0;
         for (int e = 0; e < 3 && found < 2; ++e) {
-            const Vec3 a = rig.positions.col(indices[t + static_cast<std::size_t>(e)]);
-            const Vec3 b = rig.positions.col(indices[t + static_cast<std::size_t>((e + 1) % 3)]);
-            if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
-            const Vec3 q = a + (b - a) * ((y - a.y()) / (b.y() - a.y())) - origin;
+            const std::optional<Vec3> at = crossing(rig.positions.col(indices[t + static_cast<std::size_t>(e)]),
+                                                    rig.positions.col(indices[t + static_cast<std::size_t>((e + 1) % 3)]), y);
+            if (!at) continue;
+            const Vec3 q = *at - origin;
             s[static_cast<std::size_t>(found++)] = Vec2d(double(sign * q.dot(left)), double(q.dot(forward)));
         }
         if (found == 2 && std::max(s[0].x(), s[1].x()) >= 0) segments.push_back(s);
@@ -542,18 +548,15 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         std::vector<char> chest_bones = trunk;
         for (const LimbChain* a : {&out.left_arm, &out.right_arm}) chest_bones[static_cast<std::size_t>(a->root)] = 1;
         const bool sides = armpits_on_skin == 2 && armpit_side[0] > armpit_side[1];
+        // The bust or the pectorals: the section whose front reaches farthest forward.
+        const auto front = [&](const Cut& k) { return k.center.dot(out.forward) + k.half_depth; };
         constexpr int samples = 24;
-        std::vector<Cut> cuts;
         for (int i = 0; i <= samples; ++i) {
             const Real y = waist.center.y() + (out.underarm_m - waist.center.y()) * Real(i) / samples;
             const Cut c = sides ? section(rig, indices, chest_bones, y, out.left, out.forward, armpit_side[1], armpit_side[0])
                                 : section(rig, indices, trunk, y, out.left, out.forward);
-            if (c.valid) cuts.push_back(c);
+            if (c.valid && (!chest.valid || front(c) > front(chest))) chest = c;
         }
-        // The bust or the pectorals: the section whose front reaches farthest forward.
-        const auto front = [&](const Cut& k) { return k.center.dot(out.forward) + k.half_depth; };
-        for (const Cut& c : cuts)
-            if (!chest.valid || front(c) > front(chest)) chest = c;
     }
     out.waist = make_section(waist);
     out.hips = make_section(hips.valid ? hips : waist);
@@ -578,7 +581,7 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
                            : armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk, both sides"
                            : armpits_on_skin == 1 ? "one side's lowest arm skin shared with the trunk; the other 6 % of the height under its shoulder joint"
                                                   : "6 % of the height under the shoulder joints (arms and trunk are separate pieces)"},
-        {"shoulders", (armpits_by_shape ? "the joints nearest the armpits above them, of the two chains reaching farthest sideways from spine bone "
+        {"shoulders", (armpits_by_shape ? "the upper arms' heads: the first joint above each armpit and out to the trunk's side, of the two chains reaching farthest sideways from spine bone "
                                          : "the joints of the two chains reaching farthest sideways from spine bone ") + chest_name},
     };
     return out;
