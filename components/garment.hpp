@@ -134,6 +134,11 @@ struct ClothMaterial {
 struct InertiaScales {
     Real linear = 1;   ///< Of the anchor's linear acceleration.
     Real angular = 1;  ///< Of its rotation (centrifugal and Coriolis terms).
+    /// > 0: the most linear acceleration of the anchor the particles feel (m/s^2); a step
+    /// whose felt acceleration (linear x the anchor's) is larger is felt as the linear scale
+    /// that brings it to this bound, the rest carried rigidly (an animation's root stopping
+    /// dead from 8 m/s at a jump's top). 0: no bound.
+    Real max_linear_m_s2 = 0;
     friend bool operator==(const InertiaScales&, const InertiaScales&) = default;
 };
 

@@ -10,7 +10,12 @@ namespace drape {
 void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const VectorX& drag,
                        Eigen::Index first, Eigen::Index end, const AnchorMotion& f, const InertiaScales& inertia,
                        const Vec3& g, Real h) {
-    if (inertia.linear == 1 && inertia.angular == 1) {
+    // The felt acceleration's bound (InertiaScales::max_linear_m_s2): as the scale that
+    // brings the anchor's felt acceleration to it, for the whole fixed step.
+    Real s_lin = inertia.linear;
+    const Real felt = s_lin * f.acceleration_m_s2.norm();
+    if (inertia.max_linear_m_s2 > 0 && felt > inertia.max_linear_m_s2) s_lin *= inertia.max_linear_m_s2 / felt;
+    if (s_lin == 1 && inertia.angular == 1) {
         // The particles feel all of the frame's motion: its inertial and fictitious forces
         // cancel the frame's own motion, and the motion in the frame is the motion in the
         // world. Integrated there directly: the same scheme without the frame changes.
@@ -29,9 +34,9 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
     const Vec3 w = f.angular_velocity_rad_s, w_before = f.angular_velocity_before_rad_s;
     const Vec3 w_local = r0t * w;
     // The inertial impulse of the frame's change of motion since the velocities were written.
-    const Vec3 linear_kick = inertia.linear * (f.velocity_m_s - f.velocity_before_m_s);
+    const Vec3 linear_kick = s_lin * (f.velocity_m_s - f.velocity_before_m_s);
     const Vec3 angular_kick = inertia.angular * (w - w_before);
-    const Real s_lin = inertia.linear, s_ang = inertia.angular;
+    const Real s_ang = inertia.angular;
     const Vec3 air_linear = (1 - s_lin) * f.velocity_before_m_s, air_angular = (1 - s_ang) * w_before;
     for (Eigen::Index i = first; i < end; ++i) {
         const Real inv_m = inv_mass[i];

@@ -21,6 +21,8 @@
 //   and on h), left out here. The frame's velocity changes once per fixed step, so the
 //   inertial terms -m s_lin a_b and -m s_ang dW/dt x r act as the impulse
 //   -s_lin (V - V_prev) - s_ang (W - W_prev) x (x - c0) at the step's first substep.
+//   With a bound on the felt acceleration (InertiaScales::max_linear_m_s2 > 0) a step whose
+//   s_lin |a_b| exceeds it takes s_lin x bound / (s_lin |a_b|) as its linear scale.
 // - Symplectic Euler: u += h du/dt, r += h u; then back to the world with the frame at the
 //   end of the substep: x = R1 r + c1, v = R1 u + V + W x (x - c1). With both scales 1 this
 //   is the world-frame motion, and it is integrated in the world directly (the same scheme,
@@ -45,7 +47,7 @@ struct AnchorMotion {
     Vec3 angular_velocity_rad_s = Vec3::Zero();         ///< W.
     Vec3 velocity_before_m_s = Vec3::Zero();            ///< V_prev.
     Vec3 angular_velocity_before_rad_s = Vec3::Zero();  ///< W_prev.
-    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b; the prediction does not read it (its inertial term acts through V - V_prev, and the drag no longer takes a_b h/2: docs/cloth.md, Integration).
+    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b; read only for InertiaScales::max_linear_m_s2 (its inertial term acts through V - V_prev, and the drag no longer takes a_b h/2: docs/cloth.md, Integration).
 };
 
 /// Prediction of particles [first, end): `drag` is each particle's k (N s/m).

@@ -315,6 +315,31 @@ TEST(AnchorFrame, LinearInertiaScaleSetsHowMuchOfTheBodysJerkTheParticleFeels) {
     }
 }
 
+// A bound on the felt acceleration (InertiaScales::max_linear_m_s2): a jerk of dV within a
+// step h whose felt s |dV| / h is beyond the bound b is felt as b h, the rest carried with
+// the frame, so the particle's world velocity changes by dV - b h along dV; below the bound,
+// and with none (0), the scale alone acts, (1 - s) dV.
+TEST(AnchorFrame, AnAccelerationBoundCarriesTheJerkFeltBeyondIt) {
+    const Real h = Real(1.0 / 60.0);
+    const Vec3 jerk(0, 8, 0);  // an animated jump: the root from 8 m/s up to rest within one step
+    for (const Real s : {Real(1), Real(0.5)})
+        for (const Real bound : {Real(0), Real(40), Real(1000)}) {
+            Matrix3X x = Matrix3X::Zero(3, 1), v = Matrix3X::Zero(3, 1);
+            const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+            AnchorMotion m;
+            m.velocity_before_m_s = Vec3::Zero();
+            m.velocity_m_s = jerk;
+            m.c1 = m.velocity_m_s * h;
+            m.acceleration_m_s2 = jerk / h;  // 480 m/s^2
+            predict_particles(x, v, inv_mass, drag, 0, 1, m, InertiaScales{s, 1, bound}, Vec3::Zero(), h);
+            const bool binds = bound > 0 && s * jerk.norm() / h > bound;
+            const Real expected = binds ? jerk.y() - bound * h : (1 - s) * jerk.y();
+            EXPECT_NEAR(v(1, 0), expected, 1e-4) << "s = " << s << ", bound = " << bound;
+            EXPECT_NEAR(v(0, 0), 0, 1e-6);
+            EXPECT_NEAR(x(1, 0), expected * h, 1e-5) << "s = " << s << ", bound = " << bound;
+        }
+}
+
 // A frame accelerating steadily (a, no turn) with linear inertia scale s, under gravity, no
 // drag: relative to the frame the particle feels g - s a, so over t it moves
 //   r(t) - r(0) = u0 t + (g - s a) t^2 / 2,   u0 = v0 - V(0),
