@@ -2,15 +2,20 @@
 // and writes its report (docs/reports/NAME.md and a PNG plot) and, on request, its JSON.
 // `drape bench all` refreshes every report; with --json it takes a folder and writes
 // NAME.json there for each benchmark.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <tbb/global_control.h>
 
 #include "bench/report.hpp"
 #include "drape/game/commands.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape {
 
@@ -43,7 +48,26 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     if (runs_set) c += " --runs " + std::to_string(runs);
     if (threads_set) c += " --threads " + std::to_string(threads);
     if (!o.filter.empty()) c += " --filter '" + o.filter + "'";
+    for (const auto& [name, value] : o.garment_parameters) c += " --garment-param " + name + "=" + parameter_number_text(value);
     return c;
+}
+
+// `--garment-param NAME=VALUE`: a row of the garment parameter table and a value in its
+// range; else one line naming the option, the parameter and why.
+Result<std::pair<std::string, double>> garment_param(const std::string& text) {
+    const std::size_t eq = text.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+        return fail("--garment-param '" + text + "': give NAME=VALUE (drape scene-parameters lists the names)");
+    const std::string name = text.substr(0, eq), number = text.substr(eq + 1);
+    const GarmentParameterSpec* spec = find_garment_parameter(name);
+    if (spec == nullptr)
+        return fail("--garment-param " + name + ": no garment parameter of that name (drape scene-parameters lists them)");
+    char* end = nullptr;
+    const double value = std::strtod(number.c_str(), &end);
+    if (end != number.c_str() + number.size() || !spec->range.contains(value) ||
+        (spec->kind == ParameterKind::integer && value != std::floor(value)))
+        return fail("--garment-param " + name + ": must be in " + spec->range_text() + ", got '" + number + "'");
+    return std::pair{name, value};
 }
 
 // Nothing a user wrote is replaced (game/output_files.hpp): an existing --json file needs
@@ -77,6 +101,7 @@ void add_bench_command(CLI::App& app) {
         int threads = 1;
         bool overwrite = false;
         std::string filter;
+        std::vector<std::string> garment_params;
     };
     auto cli = std::make_shared<Cli>();
     std::string names;
@@ -90,6 +115,9 @@ void add_bench_command(CLI::App& app) {
     command->add_option("--runs", cli->runs, "Repeated runs; tables show medians (default 5)")->check(CLI::Range(1, 1000));
     command->add_option("--threads", cli->threads, "Worker threads for parallel systems (default 1)")->check(CLI::Range(1, 256));
     command->add_option("--filter", cli->filter, "Only the cases whose name holds every comma-separated word (motions)");
+    command->add_option("--garment-param", cli->garment_params,
+                        "NAME=VALUE: a garment parameter (docs/scenes.md) for every garment instead of the shipped value (motions); "
+                        "repeatable");
     command->add_flag("--overwrite", cli->overwrite, "Replace an existing --json file or a NAME.md this command did not write");
     command->footer("Benchmarks: " + names + ". Each writes NAME.md and NAME*.png in the output folder "
                     "and never asserts a timing; it fails only when it cannot run.");
@@ -102,6 +130,21 @@ void add_bench_command(CLI::App& app) {
             std::string known;
             for (const auto& b : bench::benchmarks()) known += " " + b.name;
             std::fprintf(stderr, "drape bench: no benchmark named '%s' (known:%s all)\n", cli->name.c_str(), known.c_str());
+            command_exit_code() = exit_bad_input;
+            return;
+        }
+        std::vector<std::pair<std::string, double>> garment_parameters;
+        for (const std::string& text : cli->garment_params) {
+            auto parameter = garment_param(text);
+            if (!parameter) {
+                std::fprintf(stderr, "drape bench: %s\n", parameter.error().message.c_str());
+                command_exit_code() = exit_bad_input;
+                return;
+            }
+            garment_parameters.push_back(*parameter);
+        }
+        if (!garment_parameters.empty() && cli->name != "motions") {
+            std::fprintf(stderr, "drape bench: --garment-param: only the motions benchmark takes it\n");
             command_exit_code() = exit_bad_input;
             return;
         }
@@ -121,6 +164,7 @@ void add_bench_command(CLI::App& app) {
             options.runs = cli->runs;
             options.threads = cli->threads;
             options.filter = cli->filter;
+            options.garment_parameters = garment_parameters;
             if (!cli->json.empty())
                 options.json = cli->name == "all" ? std::filesystem::path(cli->json) / (b->name + ".json")
                                                   : std::filesystem::path(cli->json);

@@ -35,6 +35,7 @@
 #include "drape/engine/render/image.hpp"
 #include "drape/game/asset_paths.hpp"
 #include "drape/game/contract.hpp"
+#include "drape/systems/cloth/garment_parameters.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
 #include "drape/engine/render/renderer.hpp"
@@ -109,12 +110,22 @@ struct RunResult {
     }
 };
 
-SceneDescription case_scene(const MotionCase& c, int threads) {
+// ", but NAME = VALUE, ..." for the garment parameters given instead of the shipped ones.
+std::string changed_parameters(const BenchOptions& options) {
+    std::string text;
+    for (const auto& [name, value] : options.garment_parameters)
+        text += (text.empty() ? " but " : ", ") + name + " = " + parameter_number_text(value);
+    return text;
+}
+
+SceneDescription case_scene(const MotionCase& c, int threads,
+                            const std::vector<std::pair<std::string, double>>& garment_parameters) {
     WorldSpec spec;
     spec.garment = c.garment;
     spec.model = c.model;
     spec.threads = threads;
     SceneDescription scene = scene_for(spec);
+    for (const auto& [name, value] : garment_parameters) scene.garments.at(0).parameters.push_back({name, value});
     CharacterDescription& character = scene.characters.at(0);
     if (!c.character->default_avatar) {
         character = CharacterDescription{};
@@ -154,6 +165,7 @@ void drive_root(const MotionCase& c, int frame, int frames, Transform& transform
 
 struct RunOptions {
     int threads = 1;
+    std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.
     bool render = false;
     std::vector<int> grab_frames;     ///< Frames to render (with render).
 };
@@ -168,7 +180,7 @@ Result<void> run_case(RunResult& result, const RunOptions& options, std::vector<
     world_options.width = tile_width * render_scale;
     world_options.height = tile_height * render_scale;
 #endif
-    auto world = build_world(case_scene(c, options.threads), world_options);
+    auto world = build_world(case_scene(c, options.threads, options.garment_parameters), world_options);
     if (!world) return fail(world.error().message);
     Registry& r = world->registry;
     const Entity character = world->characters.at(0);
@@ -256,6 +268,7 @@ std::string hardest_sheet(const BenchOptions& options, const std::vector<const R
     Image sheet = blank_sheet(sheet_frames, static_cast<int>(hardest.size()), tile_width, tile_height);
     RunOptions ro;
     ro.threads = options.threads;
+    ro.garment_parameters = options.garment_parameters;
     ro.render = true;
     for (int k = 0; k < sheet_frames; ++k) ro.grab_frames.push_back((k + 1) * run_frames / sheet_frames - 1);
     for (std::size_t row = 0; row < hardest.size(); ++row) {
@@ -324,6 +337,7 @@ Result<void> run_motions(const BenchOptions& options) {
             result.c = c;
             RunOptions ro;
             ro.threads = options.threads;
+            ro.garment_parameters = options.garment_parameters;
             if (auto ok = run_case(result, ro); !ok) result.error = ok.error().message;
             std::fprintf(stderr, "drape bench motions: %s from %.2f s: %s\n", c.name().c_str(), c.start_s,
                          result.within_contract() ? "within the contract" : result.broken().c_str());
@@ -358,7 +372,7 @@ Result<void> run_motions(const BenchOptions& options) {
         "and idles loop, the others play once and hold their last pose), and on the "
         "walk four motions of the root (a spin at 1.5 rev/s, a sway of +-6 cm at 1 Hz, a stop from 2 m/s at a third of the "
         "run, a teleport of 10 m at a third); skirt and dress, simplified and classic model, " + std::to_string(starts) +
-        " start(s) spread over the clip; " + std::to_string(run_frames) + " frames of 1/60 s each, shipped settings, " +
+        " start(s) spread over the clip; " + std::to_string(run_frames) + " frames of 1/60 s each, shipped settings" + changed_parameters(options) + ", " +
         std::to_string(options.threads) + " thread(s)." + (options.filter.empty() ? "" : " Only the cases matching --filter '" + options.filter + "'.") +
         " The contract, after every whole frame: strain p99 <= 10 %, max <= 20 %, no spring under 25 % of its rest length, "
         "rise above the pins <= 15 cm, nothing non-finite, no reset (the teleport's own one apart), penetration after the "
@@ -461,8 +475,10 @@ Result<void> run_motions(const BenchOptions& options) {
 
     nlohmann::json rows_json = nlohmann::json::array();
     for (const RunResult& r : results) rows_json.push_back(row_json(r));
+    nlohmann::json garment_parameters_json = nlohmann::json::object();
+    for (const auto& [name, value] : options.garment_parameters) garment_parameters_json[name] = value;
     nlohmann::json json = {{"frames", run_frames}, {"starts", starts}, {"threads", options.threads},
-                           {"filter", options.filter}, {"runs", rows_json}};
+                           {"filter", options.filter}, {"garment_parameters", garment_parameters_json}, {"runs", rows_json}};
     return finish(report, options, json);
 }
 

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -28,6 +29,9 @@ struct BenchOptions {
     int threads = 1;                           ///< Worker threads (tbb::global_control).
     std::string command;                       ///< The command line that reproduces the run.
     std::string filter;                        ///< Comma-separated words a case's name must hold (benchmarks that list cases).
+    /// Garment parameters (docs/scenes.md's table: name, value) given to every garment of the
+    /// runs instead of the shipped values (`--garment-param NAME=VALUE`; motions only).
+    std::vector<std::pair<std::string, double>> garment_parameters;
 };
 
 /// The machine and conditions a report was measured under.

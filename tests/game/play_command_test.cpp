@@ -133,6 +133,34 @@ TEST_F(PlayCommand, CommandLineErrorsAreOneLineWithTheSameExitCodeAsOtherBadInpu
     EXPECT_TRUE(fs::is_empty(m_dir)) << "a failed run left files behind";
 }
 
+// `drape bench motions --garment-param NAME=VALUE`: a row of the garment parameter table and a
+// value in its range (docs/scenes.md), else one line naming the option and the parameter, and
+// nothing runs.
+TEST_F(PlayCommand, BenchGarmentParametersAreCheckedByName) {
+    if (drape("bench --help", m_dir).status != 0) GTEST_SKIP() << "drape is built without its benchmarks";
+    struct Case {
+        std::string args, expected;
+    };
+    const std::vector<Case> cases = {
+        {"bench motions --garment-param foo=1",
+         "drape bench: --garment-param foo: no garment parameter of that name (drape scene-parameters lists them)\n"},
+        {"bench motions --garment-param inertia_linear=2", "drape bench: --garment-param inertia_linear: must be in [0, 1], got '2'\n"},
+        {"bench motions --garment-param inertia_max_linear_m_s2=-1",
+         "drape bench: --garment-param inertia_max_linear_m_s2: must be in [0, 10000] m/s^2, got '-1'\n"},
+        {"bench motions --garment-param warp_lines=2.5",
+         "drape bench: --garment-param warp_lines: must be in integer [2, 4096], got '2.5'\n"},
+        {"bench motions --garment-param inertia_linear",
+         "drape bench: --garment-param 'inertia_linear': give NAME=VALUE (drape scene-parameters lists the names)\n"},
+        {"bench quality --garment-param inertia_linear=0.5", "drape bench: --garment-param: only the motions benchmark takes it\n"},
+    };
+    for (const Case& c : cases) {
+        const PlayRun run = drape(c.args, m_dir);
+        EXPECT_EQ(run.status, 1) << c.args;
+        EXPECT_EQ(run.output, c.expected) << c.args;
+    }
+    EXPECT_TRUE(fs::is_empty(m_dir)) << "a refused run left files behind";
+}
+
 TEST_F(PlayCommand, ASceneThatFailsWhileBuildingLeavesNoFolderBehind) {
     if (!render_available()) GTEST_SKIP() << "built without the render module (--out is refused up front there)";
     // Read and checked fine, but no collider crosses a waist 10 m up: fails in build_world.
