@@ -29,7 +29,7 @@ namespace {
 
 // A new field in any of these must be written and read below (and the format's version
 // raised); the sizes (with Eigen's alignment on x86-64) catch one added without that.
-static_assert(sizeof(FitOptions) == 88, "body_cache.cpp: add the new FitOptions field to the key");
+static_assert(sizeof(FitOptions) == 96, "body_cache.cpp: add the new FitOptions field to the key");
 static_assert(sizeof(EllipsoidShape) == 64, "body_cache.cpp: write and read the new EllipsoidShape field");
 static_assert(sizeof(BodyPoint) == 28, "body_cache.cpp: write and read the new BodyPoint field");
 static_assert(sizeof(BodySection) == 40, "body_cache.cpp: write and read the new BodySection field");
@@ -251,7 +251,7 @@ std::optional<BodyCacheKey> body_cache_key(const fs::path& character_file, const
     key << "options " << number(options.min_cluster_fraction) << ' ' << number(options.min_cluster_size) << ' '
         << number(options.tolerance_m) << ' ' << number(options.bulge_limit_m) << ' ' << number(options.target_coverage) << ' '
         << number(options.sample_spacing) << ' ' << number(options.min_radius_m) << ' ' << options.max_ellipsoids << ' '
-        << options.tight_extra_ellipsoids << ' ' << number(options.leg_reach_m) << ' ' << int(options.legs) << ' '
+        << options.tight_extra_ellipsoids << ' ' << number(options.leg_reach_m) << ' ' << number(options.arm_reach_m) << ' ' << int(options.legs) << ' '
         << number(options.knee_radius_share) << '\n';
     const std::size_t threads = std::min(static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
                                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));

@@ -264,6 +264,7 @@ Result<void> validate(const FitOptions& o) {
     if (!(o.min_radius_m > 0 && std::isfinite(o.min_radius_m))) return fail("fit.min_radius_m: must be > 0");
     if (o.max_ellipsoids < 0) return fail("fit.max_ellipsoids: must be >= 0 (0: no limit)");
     if (!(o.leg_reach_m <= 1)) return fail("fit.leg_reach_m: must be <= 1 m (< 0: no limit)");
+    if (!(o.arm_reach_m <= 1)) return fail("fit.arm_reach_m: must be <= 1 m (< 0: no limit)");
     if (!(o.target_coverage > 0 && o.target_coverage <= 1)) return fail("fit.target_coverage: must be in (0, 1]");
     if (!(o.knee_radius_share >= 0 && o.knee_radius_share <= 4)) return fail("fit.knee_radius_share: must be in [0, 4] (0: no knee spheres)");
     if (o.tight_extra_ellipsoids < 0) return fail("fit.tight_extra_ellipsoids: must be >= 0");
@@ -454,10 +455,19 @@ std::vector<EllipsoidShape> fit_with(const SkeletonAsset& skeleton, const MeshAs
         if (partner >= 0 && partner != bone_of_part[p]) part_info[p].mirror = part_of_bone[static_cast<std::size_t>(partner)];
         const BodyRegion region = region_of(static_cast<std::size_t>(bone_of_part[p]));
         part_info[p].may_split = !limb(region);
-        // Only hugged legs keep their fitted ellipsoid; the reach term on legs that are
-        // replaced by their bounding ellipsoids below would still move their neighbours.
-        part_info[p].limited_reach = tight_legs && options.leg_reach_m >= 0 &&
-                                     (region == BodyRegion::upper_leg || region == BodyRegion::lower_leg);
+        // A limb bone's piece may not reach past its own skin along the limb: an upper or
+        // lower arm always, a leg where it is hugged (only hugged legs keep their fitted
+        // ellipsoid; the reach term on legs that are replaced by their bounding ellipsoids
+        // below would still move their neighbours).
+        const bool arm = region == BodyRegion::upper_arm || region == BodyRegion::lower_arm;
+        const bool leg = region == BodyRegion::upper_leg || region == BodyRegion::lower_leg;
+        if (arm && options.arm_reach_m >= 0) {
+            part_info[p].limited_reach = true;
+            part_info[p].reach_m = options.arm_reach_m;
+        } else if (leg && tight_legs && options.leg_reach_m >= 0) {
+            part_info[p].limited_reach = true;
+            part_info[p].reach_m = options.leg_reach_m;
+        }
     }
 
     std::vector<Affine3> global, skinning;
@@ -474,7 +484,6 @@ std::vector<EllipsoidShape> fit_with(const SkeletonAsset& skeleton, const MeshAs
     settings.cover_margin_m = 0.5 * options.tolerance_m;
     settings.bulge_limit_m = options.bulge_limit_m;
     settings.min_radius_m = options.min_radius_m;
-    settings.reach_m = std::max(0.0, options.leg_reach_m);
     settings.max_pieces = options.max_ellipsoids > 0 ? options.max_ellipsoids + (tight_legs ? options.tight_extra_ellipsoids : 0) : 1 << 20;
     // Tight legs: a sphere at each knee (below), on top of the budget.
     std::vector<int> knees;

@@ -14,8 +14,12 @@
 // skin as little as possible. Where one ellipsoid cannot hug the trunk (a torso, a pelvis,
 // a head) more are added on the same bone, up to `max_ellipsoids`; a limb (arm, hand,
 // leg, foot) keeps one ellipsoid per bone: thin pieces on a limb overlap in creases at
-// the knee and the hip where the cloth's hem catches. Shapes are stored in the rigid
-// frame of their bone at the rest pose.
+// the knee and the hip where the cloth's hem catches. With `arm_reach_m` (an option, off
+// by default) an upper or lower arm's ellipsoid may not reach more than that past its own
+// skin along the arm: without it a forearm's tip hides inside the upper arm and the hand
+// at the rest pose (forearms 43-70 cm long on the characters measured) and stands into the
+// armpit and the hip once the arm hangs and bends.
+// Shapes are stored in the rigid frame of their bone at the rest pose.
 //
 // The legs (LegFit): fitted tight, each leg bone gets one ellipsoid fitted like the rest,
 // which may not reach more than `leg_reach_m` past its own skin along the leg
@@ -90,6 +94,7 @@ struct FitOptions {
     int max_ellipsoids = 32;               ///< Budget of fitted pieces (the paper's avatar has 15, a garment takes 64), knee spheres on top; 0 = no limit.
     int tight_extra_ellipsoids = 2;        ///< With tight legs the budget grows by this many pieces (the trunk's decide the bulge).
     double leg_reach_m = 0.05;             ///< A hugged leg's ellipsoid may pass its own skin along the leg by this much (< 0: no limit).
+    double arm_reach_m = -1;               ///< An upper or lower arm's ellipsoid may pass its own skin along the arm by this much (< 0, the default: no limit; docs/cloth.md, "Body fit").
     LegFit legs = LegFit::automatic;       ///< How the legs are fitted (see the header comment).
     double knee_radius_share = 1.2;        ///< Tight legs: a sphere at each knee, this x the joint's distance to the nearest leg skin (0: none).
 };

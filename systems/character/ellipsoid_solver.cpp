@@ -302,7 +302,7 @@ struct Solver {
             r[Eigen::Index(near.size() + 2 * i + 1)] = tight;
             if (piece.limited_reach) {
                 const double along = piece.reach_axis.dot(x);
-                const double past = std::max(along - piece.reach_hi, piece.reach_lo - along) - settings.reach_m;
+                const double past = std::max(along - piece.reach_hi, piece.reach_lo - along) - piece.reach_m;
                 const double area = unit_area * sphere[i].cwiseQuotient(e.radii).norm();
                 r[Eigen::Index(near.size() + 2 * m + i)] = std::sqrt(settings.bulge_weight * area / sample_area_m2) * soft_excess(past, 0, settings.huber_m);
             }
@@ -634,6 +634,7 @@ std::vector<Piece> fit_pieces(const SkinSurface& skin, const std::vector<SkinSam
                 piece.reach_lo = std::min(piece.reach_lo, along);
                 piece.reach_hi = std::max(piece.reach_hi, along);
             }
+            piece.reach_m = part_info[static_cast<std::size_t>(p)].reach_m;
         }
         for (std::uint32_t s : own) solver.piece_of[s] = static_cast<int>(solver.pieces.size());
         solver.pieces.push_back(std::move(piece));

@@ -14,7 +14,7 @@
 //     other piece): how far it stands out of the skin beyond `bulge_free_m`, fully
 //     weighted, plus a light pull on all of its stand-out. The skin's signed distance
 //     (skin_surface.hpp) is sampled on a grid, each grid point when first needed;
-//   - reach, for a part of limited reach (a leg bone), per surface point: how far it lies
+//   - reach, for a part of limited reach (a limb bone), per surface point: how far it lies
 //     past the span of the part's own samples along their longest axis, beyond `reach_m`,
 //     weighted as bulge. Without it a thin shin grows a long tip up inside the thigh (and
 //     the thigh down inside the shin): buried at the rest pose, free of cost, it stands out
@@ -77,7 +77,6 @@ struct SolverSettings {
     int iterations = 30;             ///< Levenberg-Marquardt iterations per fit at most.
     int relax_steps = 3;             ///< Budget spent and skin still uncovered: this many times ...
     double relax_step_m = 0.01;      ///< ... the pieces that leave it may stand out this much further.
-    double reach_m = 0.05;           ///< A piece of limited reach may pass its own skin along its axis by this much.
 };
 
 /// One fitted ellipsoid and the part (bone cluster) it came from.
@@ -86,16 +85,18 @@ struct Piece {
     std::vector<std::uint32_t> samples;  ///< The samples it answers for (a subset of its part).
     Ellipsoid shape;
     double extra_free_m = 0;             ///< Stand-out it may have beyond SolverSettings::bulge_free_m.
-    bool limited_reach = false;          ///< A leg's piece: it may not reach past its own skin along the leg ...
+    bool limited_reach = false;          ///< A limb's piece: it may not reach past its own skin along the limb ...
     Eigen::Vector3d reach_axis = Eigen::Vector3d::UnitX();  ///< ... along this axis (its samples' longest) ...
-    double reach_lo = 0, reach_hi = 0;   ///< ... beyond the span of its samples on it (plus SolverSettings::reach_m), m.
+    double reach_lo = 0, reach_hi = 0;   ///< ... beyond the span of its samples on it, m, ...
+    double reach_m = 0;                  ///< ... by more than this (PartInfo::reach_m).
 };
 
 /// What the solver knows of a part besides its samples.
 struct PartInfo {
     int mirror = -1;                     ///< The part on the other side (-1: none): they split together.
     bool may_split = true;               ///< More than one piece allowed (a trunk); false: one piece (a limb).
-    bool limited_reach = false;          ///< Its piece may not reach past its own skin along its axis (a leg).
+    bool limited_reach = false;          ///< Its piece may not reach past its own skin along its axis (a limb) ...
+    double reach_m = 0.05;               ///< ... by more than this.
 };
 
 /// Fits pieces to the skin samples (`skin` the same posed skin, for the signed distance). `part_of` gives each sample's part (-1: none; such

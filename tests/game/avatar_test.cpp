@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -408,6 +409,48 @@ TEST(DefaultAvatar, LegReachLeavesTheBoundingFitAlone) {
     for (std::size_t i = 0; !differ && i < c->ellipsoids.size(); ++i)
         differ = !c->ellipsoids[i].radii_m.isApprox(d->ellipsoids[i].radii_m, 1e-4f);
     EXPECT_TRUE(differ);
+}
+
+// With an arm reach (FitOptions::arm_reach_m, an option) an arm's ellipsoids stay on the
+// arm: fitted with nothing to hold them, the forearms' tips grow inside the upper arms and
+// the hands, hidden at the rest pose (the default avatar's forearm 69 cm long, its skin
+// 32 cm), and stand into the armpit and the hip once the arm hangs down. The reach is a
+// soft term of the fit, weighed against covering the skin: 2 cm over it allowed.
+TEST(DefaultAvatar, ArmEllipsoidsReachNoFurtherThanTheirSkinWithAnArmReach) {
+    const auto imported = import_character(committed_avatar);
+    ASSERT_TRUE(imported) << imported.error().message;
+    const CharacterAsset& c = **imported;
+    FitOptions options;
+    options.arm_reach_m = 0.05;
+    const auto body = fit_character_body(c, options);
+    ASSERT_TRUE(body) << body.error().message;
+    std::vector<Affine3> global, skinning;
+    compose_pose(*c.skeleton, c.skeleton->rest_local, global);
+    skinning_matrices(*c.skeleton, global, skinning);
+    Matrix3X positions, normals;
+    skin_mesh(*c.mesh, skinning, Affine3::Identity(), positions, normals);
+    const std::vector<int> dominant = dominant_bones(*c.mesh);
+    int arms = 0;
+    for (const EllipsoidShape& e : body->ellipsoids) {
+        if (e.region != BodyRegion::upper_arm && e.region != BodyRegion::lower_arm) continue;
+        ++arms;
+        const Affine3 t = ellipsoid_transform(e, global[static_cast<std::size_t>(e.bone)]);
+        Eigen::Index k = 0;
+        const Real radius = e.radii_m.maxCoeff(&k);
+        const Vec3 axis = t.linear().col(k).normalized();
+        const Real centre = axis.dot(t.translation());
+        Real lo = std::numeric_limits<Real>::max(), hi = -lo;
+        for (std::size_t j = 0; j < dominant.size(); ++j)
+            if (dominant[j] == e.bone) {
+                lo = std::min(lo, axis.dot(positions.col(static_cast<Eigen::Index>(j))));
+                hi = std::max(hi, axis.dot(positions.col(static_cast<Eigen::Index>(j))));
+            }
+        ASSERT_LT(lo, hi) << c.skeleton->bone_names[static_cast<std::size_t>(e.bone)];
+        const Real allowed = static_cast<Real>(options.arm_reach_m) + Real(0.02);
+        EXPECT_LE(centre + radius, hi + allowed) << c.skeleton->bone_names[static_cast<std::size_t>(e.bone)];
+        EXPECT_GE(centre - radius, lo - allowed) << c.skeleton->bone_names[static_cast<std::size_t>(e.bone)];
+    }
+    EXPECT_EQ(arms, 4);
 }
 
 // The avatar reshaped by a map of model space (positions, joints and the clips' bone
