@@ -456,9 +456,9 @@ std::vector<EllipsoidShape> fit_with(const SkeletonAsset& skeleton, const MeshAs
         const BodyRegion region = region_of(static_cast<std::size_t>(bone_of_part[p]));
         part_info[p].may_split = !limb(region);
         // A limb bone's piece may not reach past its own skin along the limb: an upper or
-        // lower arm always, a leg where it is hugged (only hugged legs keep their fitted
-        // ellipsoid; the reach term on legs that are replaced by their bounding ellipsoids
-        // below would still move their neighbours).
+        // lower arm when the arm reach is set (an option), a leg where it is hugged (only
+        // hugged legs keep their fitted ellipsoid; the reach term on legs that are replaced
+        // by their bounding ellipsoids below would still move their neighbours).
         const bool arm = region == BodyRegion::upper_arm || region == BodyRegion::lower_arm;
         const bool leg = region == BodyRegion::upper_leg || region == BodyRegion::lower_leg;
         if (arm && options.arm_reach_m >= 0) {
