@@ -55,9 +55,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
                                    const std::string& field, std::vector<std::string>& warnings) {
     for (const GarmentParameter& p : g.parameters) {
         const GarmentParameterSpec* spec = find_garment_parameter(p.name);
-        if (p.name != "weft_stride" && p.name != "fitting_rows" && p.name != "inertia_linear" && p.name != "inertia_angular" &&
-            p.name != "inertia_max_linear_m_s2" &&
-            !(spec && spec->in_material()))
+        if (p.name != "weft_stride" && p.name != "fitting_rows" && !p.name.starts_with("inertia_") && !(spec && spec->in_material()))
             return fail(field + "." + p.name + ": shapes a built-in garment; a garment from a file has its own shape");
     }
     MeshGarmentParams mp;
@@ -70,7 +68,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
     mp.config.integrator = params.integrator;
     mp.config.collision = params.collision;
     mp.config.material = params.material;
-    mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular, params.inertia_max_linear_m_s2};
+    mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular, params.inertia_max_linear_m_s2, params.inertia_max_fall_m_s2};
     mp.config.color = params.color;
     mp.pin_weights = params.pin_weights;
     auto mesh = import_garment_mesh(g.file, g.mesh);

@@ -458,7 +458,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.integrator, s.collision, s.color);
-    g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular, s.inertia_max_linear_m_s2};
+    g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular, s.inertia_max_linear_m_s2, s.inertia_max_fall_m_s2};
     g.body.character = character;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
     std::size_t anchor = outline.front();

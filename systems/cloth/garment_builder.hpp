@@ -73,6 +73,7 @@ struct TubeParams {
     Real inertia_linear = 1;          ///< InertiaScales::linear of the garment (1: physical).
     Real inertia_angular = 1;         ///< InertiaScales::angular.
     Real inertia_max_linear_m_s2 = 0; ///< InertiaScales::max_linear_m_s2 (0: no bound).
+    Real inertia_max_fall_m_s2 = 0;   ///< InertiaScales::max_fall_m_s2 (0: no bound).
     PinWeights pin_weights = PinWeights::nearest_vertex;  ///< How the skinned pins are bound.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;

@@ -15,7 +15,17 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
     Real s_lin = inertia.linear;
     const Real felt = s_lin * f.acceleration_m_s2.norm();
     if (inertia.max_linear_m_s2 > 0 && felt > inertia.max_linear_m_s2) s_lin *= inertia.max_linear_m_s2 / felt;
-    if (s_lin == 1 && inertia.angular == 1) {
+    // The fall bound (InertiaScales::max_fall_m_s2): the scale s_fall of the felt
+    // acceleration's part along gravity where it points down faster than the bound, for the
+    // whole fixed step; the other parts keep s_lin.
+    Real s_fall = s_lin;
+    Vec3 down = Vec3::Zero();
+    if (inertia.max_fall_m_s2 > 0 && g.squaredNorm() > 0) {
+        down = g.normalized();
+        const Real falling = s_lin * f.acceleration_m_s2.dot(down);
+        if (falling > inertia.max_fall_m_s2) s_fall = s_lin * inertia.max_fall_m_s2 / falling;
+    }
+    if (s_lin == 1 && s_fall == 1 && inertia.angular == 1) {
         // The particles feel all of the frame's motion: its inertial and fictitious forces
         // cancel the frame's own motion, and the motion in the frame is the motion in the
         // world. Integrated there directly: the same scheme without the frame changes.
@@ -34,10 +44,15 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
     const Vec3 w = f.angular_velocity_rad_s, w_before = f.angular_velocity_before_rad_s;
     const Vec3 w_local = r0t * w;
     // The inertial impulse of the frame's change of motion since the velocities were written.
-    const Vec3 linear_kick = s_lin * (f.velocity_m_s - f.velocity_before_m_s);
+    // Felt: s_lin of the change, s_fall of its part along gravity under the fall bound.
+    const Vec3 change = f.velocity_m_s - f.velocity_before_m_s;
+    Vec3 linear_kick = s_lin * change;
+    if (s_fall != s_lin) linear_kick += ((s_fall - s_lin) * change.dot(down)) * down;
     const Vec3 angular_kick = inertia.angular * (w - w_before);
     const Real s_ang = inertia.angular;
-    const Vec3 air_linear = (1 - s_lin) * f.velocity_before_m_s, air_angular = (1 - s_ang) * w_before;
+    Vec3 air_linear = (1 - s_lin) * f.velocity_before_m_s;
+    if (s_fall != s_lin) air_linear -= ((s_fall - s_lin) * f.velocity_before_m_s.dot(down)) * down;
+    const Vec3 air_angular = (1 - s_ang) * w_before;
     for (Eigen::Index i = first; i < end; ++i) {
         const Real inv_m = inv_mass[i];
         if (inv_m == 0) continue;  // pinned: follows the skin (method §3.5)

@@ -22,7 +22,11 @@
 //   inertial terms -m s_lin a_b and -m s_ang dW/dt x r act as the impulse
 //   -s_lin (V - V_prev) - s_ang (W - W_prev) x (x - c0) at the step's first substep.
 //   With a bound on the felt acceleration (InertiaScales::max_linear_m_s2 > 0) a step whose
-//   s_lin |a_b| exceeds it takes s_lin x bound / (s_lin |a_b|) as its linear scale.
+//   s_lin |a_b| exceeds it takes s_lin x bound / (s_lin |a_b|) as its linear scale. With a
+//   fall bound (InertiaScales::max_fall_m_s2 > 0) a step whose felt acceleration along
+//   gravity, s_lin a_b . d (d = g / |g|), exceeds it feels that part scaled by
+//   bound / (s_lin a_b . d) more: the impulse's and the air's parts along d take
+//   s_fall = s_lin bound / (s_lin a_b . d), their other parts s_lin.
 // - Symplectic Euler: u += h du/dt, r += h u; then back to the world with the frame at the
 //   end of the substep: x = R1 r + c1, v = R1 u + V + W x (x - c1). With both scales 1 this
 //   is the world-frame motion, and it is integrated in the world directly (the same scheme,
@@ -47,7 +51,7 @@ struct AnchorMotion {
     Vec3 angular_velocity_rad_s = Vec3::Zero();         ///< W.
     Vec3 velocity_before_m_s = Vec3::Zero();            ///< V_prev.
     Vec3 angular_velocity_before_rad_s = Vec3::Zero();  ///< W_prev.
-    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b; read only for InertiaScales::max_linear_m_s2 (its inertial term acts through V - V_prev, and the drag no longer takes a_b h/2: docs/cloth.md, Integration).
+    Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b; read only for InertiaScales::max_linear_m_s2 and max_fall_m_s2 (its inertial term acts through V - V_prev, and the drag no longer takes a_b h/2: docs/cloth.md, Integration).
 };
 
 /// Prediction of particles [first, end): `drag` is each particle's k (N s/m).

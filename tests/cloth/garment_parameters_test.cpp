@@ -23,12 +23,12 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
     // Every ClothMaterial field a garment carries is a row (10 of them), and so is every
-    // numeric field of TubeParams (15, the inertia scales and their acceleration bound, the
-    // hem clearance and the line spacing included).
+    // numeric field of TubeParams (16, the inertia scales with their acceleration and fall
+    // bounds, the hem clearance and the line spacing included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
     EXPECT_EQ(material, 10);
-    EXPECT_EQ(garment_parameters().size(), 26u);
+    EXPECT_EQ(garment_parameters().size(), 27u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {

@@ -340,6 +340,49 @@ TEST(AnchorFrame, AnAccelerationBoundCarriesTheJerkFeltBeyondIt) {
         }
 }
 
+// A fall bound (InertiaScales::max_fall_m_s2): an animated jump's root rising at 8 m/s and
+// stopping dead within a step h is a body pulled down at 8 / h = 480 m/s^2. A particle
+// rising with it under gravity g feels, along gravity, at most the bound b: its world
+// velocity becomes (b - g) h upward (at b = g it stops with the body, as cloth on a body in
+// free fall does); below the bound, and with none (0), the scale alone acts, 8 s - g h. A
+// stop as sudden sideways and a start as sudden upward are felt whole whatever the bound:
+// the particle keeps going, or is left behind.
+TEST(AnchorFrame, AFallBoundCarriesTheDownwardJerkBeyondItOnly) {
+    const Real h = Real(1.0 / 60.0);
+    const Vec3 g(0, -standard_gravity_m_s2, 0);
+    const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+    const auto step = [&](const Vec3& v_before, const Vec3& v_after, const Vec3& v0, const InertiaScales& inertia, Matrix3X& x,
+                          Matrix3X& v) {
+        x = Matrix3X::Zero(3, 1);
+        v = v0;
+        AnchorMotion m;
+        m.velocity_before_m_s = v_before;
+        m.velocity_m_s = v_after;
+        m.c1 = v_after * h;
+        m.acceleration_m_s2 = (v_after - v_before) / h;
+        predict_particles(x, v, inv_mass, drag, 0, 1, m, inertia, g, h);
+    };
+    const Vec3 up(0, 8, 0);
+    Matrix3X x, v;
+    for (const Real s : {Real(1), Real(0.5)})
+        for (const Real bound : {Real(0), standard_gravity_m_s2, Real(20), Real(1000)}) {
+            step(up, Vec3::Zero(), up, InertiaScales{s, 1, 0, bound}, x, v);
+            const bool binds = bound > 0 && s * up.y() / h > bound;
+            const Real expected = binds ? (bound - standard_gravity_m_s2) * h : s * up.y() - standard_gravity_m_s2 * h;
+            EXPECT_NEAR(v(1, 0), expected, 1e-4) << "s = " << s << ", bound = " << bound;
+            EXPECT_NEAR(v(0, 0), 0, 1e-6);
+            EXPECT_NEAR(x(1, 0), expected * h, 1e-5) << "s = " << s << ", bound = " << bound;
+        }
+    const InertiaScales free_fall{1, 1, 0, standard_gravity_m_s2};
+    const Vec3 sideways(8, 0, 0);
+    step(sideways, Vec3::Zero(), sideways, free_fall, x, v);
+    EXPECT_NEAR(v(0, 0), 8, 1e-4);
+    EXPECT_NEAR(v(1, 0), -standard_gravity_m_s2 * h, 1e-4);
+    step(Vec3::Zero(), up, Matrix3X::Zero(3, 1), free_fall, x, v);
+    EXPECT_NEAR(v(1, 0), -standard_gravity_m_s2 * h, 1e-4);
+    EXPECT_NEAR(x(1, 0), -standard_gravity_m_s2 * h * h, 1e-6);
+}
+
 // A frame accelerating steadily (a, no turn) with linear inertia scale s, under gravity, no
 // drag: relative to the frame the particle feels g - s a, so over t it moves
 //   r(t) - r(0) = u0 t + (g - s a) t^2 / 2,   u0 = v0 - V(0),
