@@ -354,7 +354,8 @@ TEST(AnchorFrame, AFallBoundCarriesTheDownwardJerkBeyondItOnly) {
     const auto step = [&](const Vec3& v_before, const Vec3& v_after, const Vec3& v0, const InertiaScales& inertia, Matrix3X& x,
                           Matrix3X& v) {
         x = Matrix3X::Zero(3, 1);
-        v = v0;
+        v.resize(3, 1);
+        v.col(0) = v0;
         AnchorMotion m;
         m.velocity_before_m_s = v_before;
         m.velocity_m_s = v_after;
@@ -378,7 +379,7 @@ TEST(AnchorFrame, AFallBoundCarriesTheDownwardJerkBeyondItOnly) {
     step(sideways, Vec3::Zero(), sideways, free_fall, x, v);
     EXPECT_NEAR(v(0, 0), 8, 1e-4);
     EXPECT_NEAR(v(1, 0), -standard_gravity_m_s2 * h, 1e-4);
-    step(Vec3::Zero(), up, Matrix3X::Zero(3, 1), free_fall, x, v);
+    step(Vec3::Zero(), up, Vec3::Zero(), free_fall, x, v);
     EXPECT_NEAR(v(1, 0), -standard_gravity_m_s2 * h, 1e-4);
     EXPECT_NEAR(x(1, 0), -standard_gravity_m_s2 * h * h, 1e-6);
 }
