@@ -55,6 +55,7 @@ constexpr double stop_speed_m_s = 2.0;
 constexpr double teleport_m = 10.0;              ///< Beyond the teleport guard's 1 m: the garment is reset once.
 constexpr int sheet_cases = 6, sheet_frames = 4;
 constexpr int tile_width = 200, tile_height = 250, render_scale = 2;
+constexpr double thin_part_m = 0.015;             ///< "Thin" body parts in the report: the body fit's thinnest pieces (1 cm) and a half more.
 
 /// The contract (docs/cloth.md, game/contract.hpp), after every whole frame, and what the
 /// suite adds to it: no reset but a teleport's.
@@ -255,6 +256,7 @@ nlohmann::json row_json(const RunResult& r) {
     j["repair_rounds_max"] = r.stats.repair_rounds_max;
     j["budget_hits"] = r.stats.budget_hits;
     j["collision_tests_per_frame"] = r.stats.collision_tests_per_frame;
+    j["worst_spring"] = worst_spring_json(r.stats.worst_spring);
     j["within_contract"] = r.within_contract();
     j["cost_bounded"] = r.cost_bounded();
     return j;
@@ -445,6 +447,41 @@ Result<void> run_motions(const BenchOptions& options) {
         report.heading("Runs outside the contract");
         report.paragraph(std::to_string(failed.size()) + " runs" + (failed.size() > 40 ? " (the 40 with the largest strain)" : "") + ".");
         report.table({"character", "clip", "motion", "garment", "model", "start s", "what broke"}, fail_rows);
+    }
+
+    // Where the torn runs tear: their worst spring's place on the garment and on the body.
+    {
+        struct Place {
+            int runs = 0, straddles = 0;
+        };
+        std::map<std::string, Place> places;
+        int torn = 0;
+        for (const RunResult& r : results) {
+            const WorstSpring& w = r.stats.worst_spring;
+            if (!r.error.empty() || !(r.stats.strain_max > 0.2) || !w.seen) continue;
+            ++torn;
+            const std::string zone = w.rows == 0 ? "?" : 10 * w.row < w.rows ? "under the pins" : 10 * w.row >= 9 * w.rows ? "at the hem" : "between";
+            const std::string part = w.body_part.empty() ? "no ellipsoid" : w.body_part + (w.part_thickness_m <= thin_part_m ? " (thin)" : "");
+            Place& p = places[part + "|" + zone + "|" + (w.weft ? "weft" : "warp")];
+            ++p.runs;
+            p.straddles += w.straddles;
+        }
+        std::vector<std::pair<std::string, Place>> sorted(places.begin(), places.end());
+        std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.second.runs > b.second.runs; });
+        std::vector<std::vector<std::string>> place_rows;
+        for (const auto& [key, p] : sorted) {
+            const auto a = key.find('|'), b = key.find('|', a + 1);
+            place_rows.push_back({key.substr(0, a), key.substr(a + 1, b - a - 1), key.substr(b + 1), std::to_string(p.runs),
+                                  std::to_string(p.straddles)});
+        }
+        report.heading("Where the torn runs tear");
+        report.paragraph(std::to_string(torn) + " runs with a spring over 20 %: where each one's worst spring was when it was "
+                         "worst (the stats file's strain.worst; systems/cloth/garment_quality.hpp SpringPlace). The body part "
+                         "is the ellipsoid nearest the spring's middle, thin when its smallest radius is at most " +
+                         fixed(100 * thin_part_m, 1) + " cm; the place on the garment is its row: the first tenth under the "
+                         "pins, the last tenth at the hem. Straddled: the spring's chord passed through that ellipsoid, its "
+                         "two ends on sides of it more than 60 degrees apart (a piece caught between two neighbours).");
+        if (!place_rows.empty()) report.table({"body part", "on the garment", "spring", "runs", "straddled"}, place_rows);
     }
 
     // The hardest runs, rendered: the largest strains, one per character x motion x garment.

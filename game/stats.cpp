@@ -6,8 +6,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drape/components/ellipsoid_collider.hpp"
 #include "drape/components/garment.hpp"
 #include "drape/game/skin_penetration.hpp"
+#include "drape/systems/cloth/body.hpp"
 
 namespace drape {
 
@@ -25,6 +27,25 @@ GarmentWatch::GarmentWatch(const Registry& registry, std::vector<Entity> garment
     }
 }
 
+namespace {
+
+// Where the spring of q.strain_max lies, with its nearest ellipsoid's body region.
+WorstSpring worst_spring(const Registry& registry, const Garment& g, const GarmentQuality& q, std::uint64_t frame) {
+    std::vector<EllipsoidFrame> frames;
+    update_frames(registry, g.body, frames, 1);
+    const SpringPlace place = place_spring(g, frames, q.worst_a, q.worst_b);
+    WorstSpring w{.seen = true, .frame = frame, .weft = place.weft, .line = place.line, .row = place.row, .rows = place.rows,
+                  .straddles = place.straddles};
+    if (place.collider >= 0) {
+        w.part_thickness_m = place.thickness_m;
+        if (const auto* c = registry.try_get<EllipsoidCollider>(g.body.colliders[static_cast<std::size_t>(place.collider)]))
+            w.body_part = body_region_name(c->region);
+    }
+    return w;
+}
+
+}  // namespace
+
 void GarmentWatch::sample(const Registry& registry) {
     ++m_frames;
     // The worst so far; a NaN stays (it is written as null: a bug to report).
@@ -38,6 +59,8 @@ void GarmentWatch::sample(const Registry& registry) {
         const GarmentQuality q = measure_garment(registry, *g, t.strains.get());
         m_latest_strain_p99 = std::max(m_latest_strain_p99, double(q.strain_p99));
         GarmentStats& w = t.worst;
+        if (q.springs > 0 && (!w.worst_spring.seen || q.strain_max > w.strain_max))
+            w.worst_spring = worst_spring(registry, *g, q, m_frames);
         worse(w.strain_max, q.strain_max);
         worse(w.pinned_strain_max, q.pinned_strain_max);
         worse(w.penetration_after_frame_m, q.penetration_m);
@@ -103,6 +126,18 @@ RunStats make_run_stats(const FrameProfiler& profiler, double sim_dt_s, const Ga
     return r;
 }
 
+nlohmann::json worst_spring_json(const WorstSpring& w) {
+    if (!w.seen) return nullptr;
+    return {{"frame", w.frame},
+            {"spring", w.weft ? "weft" : "warp"},
+            {"line", w.line},
+            {"row", w.row},
+            {"rows", w.rows},
+            {"body_part", w.body_part.empty() ? nlohmann::json(nullptr) : nlohmann::json(w.body_part)},
+            {"part_thickness_m", w.body_part.empty() ? nlohmann::json(nullptr) : nlohmann::json(w.part_thickness_m)},
+            {"straddles", w.straddles}};
+}
+
 std::string stats_json(const RunStats& stats) {
     using Json = nlohmann::ordered_json;
     // JSON has no NaN or infinity: a non-finite figure is written as null (and is a bug to report).
@@ -121,7 +156,11 @@ std::string stats_json(const RunStats& stats) {
     Json garments = Json::array();
     for (const GarmentStats& g : stats.garments)
         garments.push_back({{"particles", g.particles},
-                            {"strain", {{"max", number(g.strain_max)}, {"p99", number(g.strain_p99)}, {"pinned_max", number(g.pinned_strain_max)}}},
+                            {"strain",
+                             {{"max", number(g.strain_max)},
+                              {"p99", number(g.strain_p99)},
+                              {"pinned_max", number(g.pinned_strain_max)},
+                              {"worst", Json(worst_spring_json(g.worst_spring))}}},
                             {"compression_min", number(g.compression_min)},
                             {"penetration_m",
                              {{"after_frame_max", number(g.penetration_after_frame_m)},

@@ -4,7 +4,9 @@
 //    "characters": [{"file", "clip", "height_m"}],
 //    "systems": {NAME: {"runs", "skips", "mean_ms", "p50_ms", "p95_ms", "max_ms"}},
 //    "garments": [{"particles",
-//                  "strain": {"max", "p99"},
+//                  "strain": {"max", "p99", "pinned_max",
+//                             "worst": {"frame", "spring", "line", "row", "rows", "body_part",
+//                                       "part_thickness_m", "straddles"}},
 //                  "penetration_m": {"after_frame_max", "before_response_max", "within_give_max",
 //                                    "below_ground_max"},
 //                  "skin_penetration_m": {"p99", "max", "share"},
@@ -15,6 +17,10 @@
 // frame (systems/cloth/garment_quality.hpp) and are the worst seen over the run, except
 // `strain.p99`: the 99th percentile over every spring of every frame. `max_strain` and
 // `max_penetration_m` repeat `strain.max` and `penetration_m.before_response_max`.
+// `strain.worst` says where the run's worst spring was when it was worst (SpringPlace): the
+// frame, "warp" or "weft", its first end's line and row (0 at the fitting zone) of `rows`,
+// the region of the ellipsoid nearest its middle and that ellipsoid's smallest radius, and
+// whether it straddled it; null when no spring was measured.
 // Penetration counts the depth past an ellipsoid's give (EllipsoidCollider::give_m);
 // `within_give_max` is the deepest a free particle lay inside a giving ellipsoid within it;
 // `below_ground_max` the deepest a free particle lay under the floor (the scene's `ground`).
@@ -30,12 +36,32 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "drape/engine/core/error.hpp"
 #include "drape/engine/core/profiler.hpp"
 #include "drape/engine/core/registry.hpp"
 #include "drape/systems/cloth/garment_quality.hpp"
 
 namespace drape {
+
+/// Where a run's worst spring was when it was worst (systems/cloth/garment_quality.hpp
+/// SpringPlace, with the nearest ellipsoid's body region).
+struct WorstSpring {
+    bool seen = false;              ///< A spring was measured.
+    std::uint64_t frame = 0;        ///< The frame it was worst after (1: the first sampled).
+    bool weft = false;              ///< A weft spring, else a warp spring.
+    std::uint32_t line = 0;         ///< Warp line of its first end.
+    std::uint32_t row = 0;          ///< Row of its first end, 0 at the fitting zone.
+    std::uint32_t rows = 0;         ///< Rows of the garment.
+    std::string body_part = {};     ///< Region of the ellipsoid nearest its middle (body_region_name); empty: none.
+    double part_thickness_m = 0;    ///< That ellipsoid's smallest radius.
+    bool straddles = false;         ///< Its chord passed through that ellipsoid.
+};
+
+/// `strain.worst` of the stats file: {"frame", "spring", "line", "row", "rows", "body_part",
+/// "part_thickness_m", "straddles"}, or null when no spring was measured.
+[[nodiscard]] nlohmann::json worst_spring_json(const WorstSpring& worst);
 
 /// One garment over a run.
 struct GarmentStats {
@@ -59,6 +85,7 @@ struct GarmentStats {
     double collision_tests_per_frame = 0;///< Particle-ellipsoid tests per rendered frame, mean.
     int repair_rounds_max = 0;           ///< Most contact repair rounds in one frame.
     std::uint64_t budget_hits = 0;       ///< Substeps whose contact repair ran out of its round budget.
+    WorstSpring worst_spring = {};       ///< Where the spring of strain_max was.
 };
 
 /// A character of the run: its file, the clip it plays, its height.

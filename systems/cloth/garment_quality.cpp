@@ -63,6 +63,7 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
 
     std::vector<Real> strains;
     strains.reserve(t.warp1.size() + t.warp2.size() + t.weft.size());
+    Real worst = -1;
     for (const SpringPhase* phase : {&t.warp1, &t.warp2, &t.weft})
         for (std::size_t s = 0; s < phase->size(); ++s) {
             const std::uint32_t a = phase->a[s], b = phase->b[s];
@@ -75,6 +76,11 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
             const Real strain = std::isfinite(ratio) ? std::max(Real(0), ratio - 1) : std::numeric_limits<Real>::infinity();
             strains.push_back(strain);
             if (histogram) histogram->add(strain);
+            if (strain > worst) {
+                worst = strain;
+                q.worst_a = a;
+                q.worst_b = b;
+            }
         }
     q.springs = strains.size();
     if (!strains.empty()) {
@@ -113,6 +119,43 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
         }
     }
     return q;
+}
+
+SpringPlace place_spring(const Garment& g, std::span<const EllipsoidFrame> frames, std::uint32_t a, std::uint32_t b) {
+    SpringPlace place;
+    if (!g.fabric) return place;
+    const Fabric& t = *g.fabric;
+    const std::uint32_t m = t.particles_per_line;
+    place.rows = m;
+    // Grid places of the two ends (Fabric::grid maps a place to its particle).
+    std::size_t at_a = t.grid.size(), at_b = t.grid.size();
+    for (std::size_t k = 0; k < t.grid.size(); ++k) {
+        if (t.grid[k] == a) at_a = k;
+        if (t.grid[k] == b) at_b = k;
+    }
+    if (at_a == t.grid.size() || at_b == t.grid.size() || m == 0) return place;
+    place.line = static_cast<std::uint32_t>(at_a / m);
+    place.row = static_cast<std::uint32_t>(at_a % m);
+    place.weft = at_a / m != at_b / m;
+    const Matrix3X& x = g.state.x;
+    const Vec3 middle = Real(0.5) * (x.col(a) + x.col(b));
+    if (!middle.allFinite()) return place;
+    Real nearest = std::numeric_limits<Real>::infinity();
+    for (std::size_t e = 0; e < frames.size(); ++e) {
+        if (!frames[e].active) continue;
+        const Real d = to_unit_sphere(frames[e], middle).norm();
+        if (d < nearest) {
+            nearest = d;
+            place.collider = static_cast<std::int32_t>(e);
+        }
+    }
+    if (place.collider < 0) return place;
+    const EllipsoidFrame& f = frames[static_cast<std::size_t>(place.collider)];
+    place.thickness_m = f.radii_m.minCoeff();
+    place.unit_distance = nearest;
+    const Vec3 ua = to_unit_sphere(f, x.col(a)).normalized(), ub = to_unit_sphere(f, x.col(b)).normalized();
+    place.straddles = nearest < 1 && ua.dot(ub) < Real(0.5);
+    return place;
 }
 
 GarmentQuality measure_garment(const Registry& registry, const Garment& garment, StrainHistogram* histogram) {

@@ -51,7 +51,32 @@ struct GarmentQuality {
     Real rise_above_pins_m = 0;     ///< See the conventions above.
     std::uint64_t nonfinite = 0;    ///< Non-finite coordinates in x and v.
     std::uint64_t springs = 0;      ///< Springs measured.
+    std::uint32_t worst_a = 0;      ///< The spring of strain_max: its end nearer the pins (warp) or before it round the
+    std::uint32_t worst_b = 0;      ///< ring (weft), and its other end; equal when no spring was measured.
 };
+
+/// Where a spring lies on the garment and on the body: what a tear is caught on. The body
+/// part is the ellipsoid nearest the spring's middle in unit-sphere terms (the measure the
+/// pins are bound by); the spring straddles it when its chord passes through it (its middle
+/// inside) with its two ends on sides of it more than 60 degrees apart, seen from its centre
+/// in unit-sphere terms, which a spring lying over a surface shows only where the surface
+/// bends tighter than the spring is long: a piece thinner than the cloth's spacing holding
+/// two neighbours apart.
+struct SpringPlace {
+    bool weft = false;              ///< A weft spring (round the body), else a warp spring (down a line).
+    std::uint32_t line = 0;         ///< Warp line of its first end.
+    std::uint32_t row = 0;          ///< Row of its first end, 0 at the fitting zone.
+    std::uint32_t rows = 0;         ///< Rows of the garment (particles per line).
+    std::int32_t collider = -1;     ///< Nearest ellipsoid: index into the frames (GarmentBody::colliders); -1: none.
+    Real thickness_m = 0;           ///< That ellipsoid's smallest radius.
+    Real unit_distance = 0;         ///< The spring's middle from its centre in unit-sphere terms (1: on its surface).
+    bool straddles = false;         ///< See above.
+};
+
+/// Where the spring between particles `a` and `b` lies, against `frames` (the colliders as
+/// the cloth sees them).
+[[nodiscard]] SpringPlace place_spring(const Garment& garment, std::span<const EllipsoidFrame> frames, std::uint32_t a,
+                                       std::uint32_t b);
 
 /// Strain histogram over many frames, for percentiles of a whole run (bins of 0.1 %).
 class StrainHistogram {

@@ -341,6 +341,63 @@ TEST(Pins, ThePinnedRowsOwnStrainIsMeasuredApart) {
     EXPECT_LT(after.pinned_strain_max, Real(0.6));
 }
 
+// The worst spring is found and placed: its line and row, the ellipsoid nearest its middle,
+// and whether its chord passes through that ellipsoid (a piece thinner than the cloth's
+// spacing holding two neighbours apart) or only lies over it.
+TEST(SpringPlaceTest, TheWorstSpringIsPlacedOnTheGarmentAndTheBody) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, TubeParams::skirt());
+    scene.run(1);
+    Garment& g = scene.registry.get<Garment>(e);
+    const Fabric& f = *g.fabric;
+    const std::uint32_t m = f.particles_per_line, line = 4;
+    // The hem particle of line 4 pulled down the line by 60 % of its warp spring's rest length.
+    const std::uint32_t above = f.grid[line * m + m - 2], hem = f.grid[line * m + m - 1];
+    const Vec3 down = (g.state.x.col(hem) - g.state.x.col(above)).normalized();
+    const Real warp_rest = (f.rest_shape.col(line * m + m - 1) - f.rest_shape.col(line * m + m - 2)).norm();
+    g.state.x.col(hem) = g.state.x.col(above) + Real(1.6) * warp_rest * down;
+    const GarmentQuality q = measure_garment(scene.registry, g);
+    EXPECT_GT(q.strain_max, Real(0.55));
+    EXPECT_EQ(q.worst_a, above);
+    EXPECT_EQ(q.worst_b, hem);
+    const std::vector<EllipsoidFrame> none;
+    const SpringPlace pulled = place_spring(g, none, q.worst_a, q.worst_b);
+    EXPECT_FALSE(pulled.weft);
+    EXPECT_EQ(pulled.line, line);
+    EXPECT_EQ(pulled.row, m - 2);
+    EXPECT_EQ(pulled.rows, m);
+    EXPECT_EQ(pulled.collider, -1);
+
+    // A weft spring halfway down, between a rod 3 mm thick through its middle and a trunk
+    // 20 cm round behind it; then lying on the trunk alone.
+    const std::uint32_t row = m / 2;
+    const std::uint32_t a = f.grid[line * m + row], b = f.grid[(line + 1) * m + row];
+    const auto frame = [](const Vec3& centre, const Vec3& radii) {
+        EllipsoidFrame fr;
+        fr.center = centre;
+        fr.radii_m = radii;
+        fr.to_unit = radii.cwiseInverse().asDiagonal();
+        fr.active = true;
+        return fr;
+    };
+    const Vec3 middle = Real(0.5) * (g.state.x.col(a) + g.state.x.col(b));
+    const Vec3 out = (middle - Vec3(0, middle.y(), 0)).normalized();  // away from the body's axis
+    const EllipsoidFrame trunk = frame(middle - Real(0.2) * out, Vec3::Constant(Real(0.2)));
+    const std::vector<EllipsoidFrame> rod = {trunk, frame(middle, Vec3(Real(0.003), Real(0.05), Real(0.003)))};
+    const SpringPlace held = place_spring(g, rod, a, b);
+    EXPECT_TRUE(held.weft);
+    EXPECT_EQ(held.line, line);
+    EXPECT_EQ(held.row, row);
+    EXPECT_EQ(held.collider, 1);
+    EXPECT_FLOAT_EQ(held.thickness_m, Real(0.003));
+    EXPECT_TRUE(held.straddles);
+    const SpringPlace lying = place_spring(g, std::vector<EllipsoidFrame>{trunk}, a, b);
+    EXPECT_EQ(lying.collider, 0);
+    EXPECT_FLOAT_EQ(lying.thickness_m, Real(0.2));
+    EXPECT_NEAR(lying.unit_distance, 1, 1e-3);
+    EXPECT_FALSE(lying.straddles);
+}
+
 TEST(Substeps, RuleFollowsStabilityAndColliderSpeed) {
     Registry registry;
     test::WalkSettings still;

@@ -52,6 +52,8 @@ RunStats example() {
     r.garments.back().skin_penetration_p99_m = 0.004;
     r.garments.back().skin_penetration_max_m = 0.006;
     r.garments.back().skin_penetration_share = 0.01;
+    r.garments.back().worst_spring = {.seen = true, .frame = 12, .weft = true, .line = 58, .row = 26, .rows = 84,
+                                      .body_part = "torso", .part_thickness_m = 0.01, .straddles = true};
     return r;
 }
 
@@ -81,7 +83,18 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     EXPECT_DOUBLE_EQ(g["compression_min"].get<double>(), 0.8);
     EXPECT_EQ(g["repair_rounds_max"], 7);
     EXPECT_EQ(g["budget_hits"], 3);
-    EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99", "pinned_max"}));
+    EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99", "pinned_max", "worst"}));
+    const auto& worst = g["strain"]["worst"];
+    EXPECT_EQ(keys(worst), (std::vector<std::string>{"body_part", "frame", "line", "part_thickness_m", "row", "rows",
+                                                     "spring", "straddles"}));
+    EXPECT_EQ(worst["frame"], 12);
+    EXPECT_EQ(worst["spring"], "weft");
+    EXPECT_EQ(worst["line"], 58);
+    EXPECT_EQ(worst["row"], 26);
+    EXPECT_EQ(worst["rows"], 84);
+    EXPECT_EQ(worst["body_part"], "torso");
+    EXPECT_DOUBLE_EQ(worst["part_thickness_m"].get<double>(), 0.01);
+    EXPECT_EQ(worst["straddles"], true);
     EXPECT_DOUBLE_EQ(g["strain"]["pinned_max"].get<double>(), 0.3);
     EXPECT_EQ(keys(g["penetration_m"]), (std::vector<std::string>{"after_frame_max", "before_response_max", "below_ground_max", "within_give_max"}));
     EXPECT_DOUBLE_EQ(g["strain"]["p99"].get<double>(), 0.05);
@@ -166,6 +179,24 @@ TEST(GarmentWatch, StrainIsMeasuredOnTheGarmentAfterTheFrame) {
     EXPECT_NEAR(result[0].strain_max, 0.2, 1e-4);
     EXPECT_GT(result[0].strain_p99, 0.0);  // the histogram saw the stretched springs
     EXPECT_EQ(result[0].pins_inside_m, 0.0);
+    // Where it was: the warp spring from row 2 to the hem on line 0, in the first frame; the
+    // rectangle hangs in the air (no ellipsoid near).
+    const WorstSpring& worst = result[0].worst_spring;
+    EXPECT_TRUE(worst.seen);
+    EXPECT_EQ(worst.frame, 1u);
+    EXPECT_FALSE(worst.weft);
+    EXPECT_EQ(worst.line, 0u);
+    EXPECT_EQ(worst.row, 2u);
+    EXPECT_EQ(worst.rows, 4u);
+    EXPECT_TRUE(worst.body_part.empty());
+    EXPECT_FALSE(worst.straddles);
+}
+
+TEST(StatsFile, NoWorstSpringIsWrittenAsNull) {
+    RunStats r = example();
+    r.garments.back().worst_spring = {};
+    const nlohmann::json j = nlohmann::json::parse(stats_json(r));
+    EXPECT_TRUE(j["garments"][0]["strain"]["worst"].is_null());
 }
 
 }  // namespace
