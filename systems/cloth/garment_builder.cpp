@@ -467,8 +467,14 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     // Hung from under the arms, the garment has the upper arms outside it: they hang against
     // the chest, their ellipsoids overlap it, and cloth between the two cannot be outside
     // both. It does not collide with them: it stays on the chest, under the arm.
+    // With thin_trunk_piece_m, nor with the trunk's pieces thinner than that (docs/cloth.md,
+    // "Thin trunk pieces"): standing between two neighbouring particles, each pushed out to
+    // its own side, they hold the cloth open.
     for (std::size_t e = 0; e < colliders.size(); ++e) {
-        if (s.ring_at == RingPlace::under_arms && registry.get<EllipsoidCollider>(colliders[e]).region == BodyRegion::upper_arm)
+        const BodyRegion region = registry.get<EllipsoidCollider>(colliders[e]).region;
+        if (s.ring_at == RingPlace::under_arms && region == BodyRegion::upper_arm) continue;
+        if (s.thin_trunk_piece_m > 0 && e != anchor && (region == BodyRegion::torso || region == BodyRegion::pelvis) &&
+            frames[e].radii_m.minCoeff() <= s.thin_trunk_piece_m)
             continue;
         if (e == anchor) g.body.anchor = static_cast<std::int32_t>(g.body.colliders.size());
         g.body.colliders.push_back(colliders[e]);

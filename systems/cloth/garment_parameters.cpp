@@ -141,6 +141,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "> 0: the most of the body's linear acceleration the cloth feels (x `inertia_linear`); beyond it the rest is carried rigidly (an animated jump stopping dead at its top); 0: no bound"),
         real("inertia_max_fall_m_s2", &TubeParams::inertia_max_fall_m_s2, closed(0, 1e4), "m/s^2",
              "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall); the downward part beyond it is carried rigidly; 0: no bound"),
+        real("thin_trunk_piece_m", &TubeParams::thin_trunk_piece_m, closed(0, 1), "m",
+             "> 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is at most this (pieces that stand between neighbouring particles and hold the cloth open; the anchor's kept); 0: with every ellipsoid"),
         real("areal_density_kg_m2", &ClothMaterial::areal_density_kg_m2, open_min(0, 10), "kg/m^2",
              "mass per area of the cloth (cotton 0.1-0.2, denim 0.3-0.45)"),
         real("stretch_N_m", &ClothMaterial::stretch_N_m, open_min(0, 1e7), "N/m",

@@ -28,7 +28,7 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
     EXPECT_EQ(material, 10);
-    EXPECT_EQ(garment_parameters().size(), 27u);
+    EXPECT_EQ(garment_parameters().size(), 28u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {

@@ -1,6 +1,7 @@
 // Builders, pins, substeps, counters, reset and determinism (method §3.2, §3.4, §3.5).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include <tbb/global_control.h>
@@ -396,6 +397,38 @@ TEST(SpringPlaceTest, TheWorstSpringIsPlacedOnTheGarmentAndTheBody) {
     EXPECT_FLOAT_EQ(lying.thickness_m, Real(0.2));
     EXPECT_NEAR(lying.unit_distance, 1, 1e-3);
     EXPECT_FALSE(lying.straddles);
+}
+
+// With thin_trunk_piece_m a built garment leaves out of its collision the trunk's pieces at
+// most that thin, and only those: a torso piece 1 cm thin in front of the pelvis is among the
+// skirt's colliders by default and at 5 mm, and not at 1.5 cm; the anchor is another piece.
+TEST(GarmentBuilder, ThinTrunkPiecesAreLeftOutOfTheCollisionWithTheOption) {
+    for (const Real thin : {Real(0), Real(0.005), Real(0.015)}) {
+        SCOPED_TRACE("thin_trunk_piece_m " + std::to_string(thin));
+        Registry registry;
+        test::AnalyticBody body(registry);
+        const Vec3 front = registry.get<EllipsoidCollider>(body.colliders[0]).world.translation() + Vec3(0, 0, Real(0.12));
+        EllipsoidCollider c;
+        c.character = body.character;
+        c.region = BodyRegion::torso;
+        c.world = Affine3::Identity();
+        c.world.translate(front);
+        c.world.scale(Vec3(Real(0.03), Real(0.05), Real(0.01)));
+        c.previous_world = c.world;
+        c.placed = c.initialised = true;
+        const Entity piece = registry.create();
+        registry.emplace<EllipsoidCollider>(piece, c);
+        TubeParams params = TubeParams::skirt();
+        params.thin_trunk_piece_m = thin;
+        const auto e = attach_skirt(registry, body.character, params);
+        ASSERT_TRUE(e) << e.error().message;
+        const GarmentBody& b = registry.get<Garment>(*e).body;
+        const bool collides = std::find(b.colliders.begin(), b.colliders.end(), piece) != b.colliders.end();
+        EXPECT_EQ(collides, thin < Real(0.01));
+        EXPECT_EQ(b.colliders.size(), body.colliders.size() + (collides ? 1 : 0));
+        ASSERT_GE(b.anchor, 0);
+        EXPECT_NE(b.colliders[static_cast<std::size_t>(b.anchor)], piece);
+    }
 }
 
 TEST(Substeps, RuleFollowsStabilityAndColliderSpeed) {
