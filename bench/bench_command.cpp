@@ -114,7 +114,7 @@ void add_bench_command(CLI::App& app) {
     command->add_option("--out", cli->out, "Folder for the Markdown reports and plots (default docs/reports)");
     command->add_option("--runs", cli->runs, "Repeated runs; tables show medians (default 5)")->check(CLI::Range(1, 1000));
     command->add_option("--threads", cli->threads, "Worker threads for parallel systems (default 1)")->check(CLI::Range(1, 256));
-    command->add_option("--filter", cli->filter, "Only the cases whose name holds every comma-separated word (motions)");
+    command->add_option("--filter", cli->filter, "Only the cases whose name holds every comma-separated word (motions, garments, cut, stability)");
     command->add_option("--garment-param", cli->garment_params,
                         "NAME=VALUE: a garment parameter (docs/scenes.md) for every garment instead of the shipped value (motions); "
                         "repeatable");

@@ -23,15 +23,18 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "bench/characters.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
 #include "drape/components/animation_player.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
 #include "drape/components/transform.hpp"
 #include "drape/systems/cloth/garment_config.hpp"
 #include "drape/systems/cloth/garment_quality.hpp"
 #include "drape/systems/cloth/garment_step.hpp"
 #include "drape/systems/cloth/integrator.hpp"
 #include "drape/systems/cloth/substeps.hpp"
+#include "drape/systems/teleport_guard_system.hpp"
 
 namespace drape::bench {
 
@@ -157,11 +160,25 @@ struct Case {
     int capped_frames = 0;
     double strain_max = 0, strain_p99 = 0, penetration_m = 0;
     double mean_substeps = 0, worst_reach = 0;
+    double body_speed_m_s = 0;   ///< The fastest surface of the body over the run (world frame).
+    double energy_peak_J = 0;    ///< The garment's kinetic energy, its peak over the run.
 };
 
 std::string outcome(const Case& c) {
     if (c.capped) return c.divergence.diverged ? "capped, diverged" : "capped";
     return c.divergence.diverged ? "diverged" : "ok";
+}
+
+// The fastest a surface of the character's ellipsoids moves in the world this step: each
+// one's centre speed plus its spin times its largest radius.
+double body_surface_speed_m_s(Registry& r, Entity character) {
+    double fastest = 0;
+    r.view<EllipsoidCollider>().each([&](Entity, const EllipsoidCollider& e) {
+        if (e.character != character) return;
+        fastest = std::max(fastest, static_cast<double>(e.velocity_m_s.norm() +
+                                                        e.angular_velocity_rad_s.norm() * e.radii_m.maxCoeff()));
+    });
+    return fastest;
 }
 
 double garment_mass_kg(const Garment& g) {
@@ -179,10 +196,13 @@ Result<void> run_case(World& world, const ClothMaterial& material, const PinReac
     auto& player = r.get<AnimationPlayer>(character);
     const Transform home = transform;
     // The body back where the last case left it (home, playing) for one step, so that its
-    // colliders are there too; then the garment at rest around it.
+    // colliders are there too; that jump home is no motion (a spin's last case ends half a
+    // turn away: its colliders would carry hundreds of rad/s into the garment's reset), so
+    // their motion is forgotten, as after a teleport; then the garment at rest around it.
     player.speed = 1;
     player.playing = true;
     if (auto ok = step_world(world, c.frame_dt_s); !ok) return fail(ok.error().message);
+    forget_collider_motion(r, character);
     if (auto ok = set_garment_material(r, world.garments.at(0), material); !ok) return fail(ok.error().message);
     reset_garments(world);
     if (const double start = worst_reach_ratio(first_garment(world).state.x, reach); !(start <= 1 + base_limits.reach_factor))
@@ -223,6 +243,7 @@ Result<void> run_case(World& world, const ClothMaterial& material, const PinReac
         }
         if (auto ok = step_world(world, c.frame_dt_s); !ok) return fail(ok.error().message);
         const Garment& g = first_garment(world);
+        c.body_speed_m_s = std::max(c.body_speed_m_s, body_surface_speed_m_s(r, character));
         substeps += g.counters.substeps;
         if (c.auto_substeps && (g.counters.substeps_stability >= stability_cap || g.counters.substeps_motion >= cap)) {
             c.capped = true;
@@ -249,6 +270,7 @@ Result<void> run_case(World& world, const ClothMaterial& material, const PinReac
             break;  // ran away: the rest of the run says nothing more
         }
     }
+    if (!trace.energy_J.empty()) c.energy_peak_J = *std::max_element(trace.energy_J.begin(), trace.energy_J.end());
     c.divergence = classify_divergence(trace, limits);
     c.worst_reach = trace.worst_reach_ratio;
     c.strain_p99 = histogram.samples() > 0 ? static_cast<double>(histogram.percentile(0.99)) : NAN;
@@ -404,6 +426,7 @@ Result<void> run_stability(const BenchOptions& options) {
                         c.name = std::string(cloth_integrator_name(integrator)) + "/" + garment_type_name(garment) + "/" + motion_name(motion) + "/k=" +
                                  k_label(c.k_N_m) + (c.default_material ? " (shipped)" : "") + "/dt=" + step_label(dt) +
                                  (automatic ? "/auto" : "/1-substep");
+                        if (!matches_filter(c.name, options.filter)) continue;
                         if (auto ok = run_case(*world, material, reach, c); !ok)
                             return fail("stability: " + c.name + ": " + ok.error().message);
                         cases.push_back(c);
@@ -411,6 +434,8 @@ Result<void> run_stability(const BenchOptions& options) {
             }
         }
     }
+
+    if (cases.empty()) return fail("stability: no case matched (--filter '" + options.filter + "')");
 
     // The integrator alone.
     std::vector<double> chain_moduli;
@@ -487,7 +512,9 @@ Result<void> run_stability(const BenchOptions& options) {
                                  {"strain_max", c.strain_max},
                                  {"strain_p99", std::isfinite(c.strain_p99) ? nlohmann::json(c.strain_p99) : nlohmann::json()},
                                  {"penetration_m", c.penetration_m},
-                                 {"worst_reach_ratio", c.worst_reach}});
+                                 {"worst_reach_ratio", c.worst_reach},
+                                 {"body_speed_m_s", c.body_speed_m_s},
+                                 {"energy_peak_J", c.energy_peak_J}});
     for (const ClothIntegrator integrator : integrators) {
         const Counts& n = counts[integrator == ClothIntegrator::paper ? 1 : 0];
         const double soft = walk_p99(integrator, moduli[0]), stiff = walk_p99(integrator, moduli[std::size(moduli) - 1]);
@@ -541,6 +568,9 @@ Result<void> run_stability(const BenchOptions& options) {
         "springs' stability bound (systems/cloth/integrator.hpp spring_step_limit_s) and are capped only at " +
         std::to_string(ClothSolverSettings{}.max_stability_substeps) + " (ClothSolverSettings::max_stability_substeps); "
         "it runs on the skirt only (the dress at 1e6 N/m would take hours).");
+    if (!options.filter.empty())
+        report.paragraph("Only the cases whose name matches --filter '" + options.filter + "' ran (" + std::to_string(cases.size()) +
+                         " cases); the summary counts those.");
 
     report.heading("Summary");
     std::vector<Target> targets;

@@ -1,6 +1,7 @@
 // Teleport guard: see teleport_guard_system.hpp.
 #include "drape/systems/teleport_guard_system.hpp"
 
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -11,6 +12,17 @@
 #include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
+
+void forget_collider_motion(Registry& registry, Entity character) {
+    registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
+        if (c.character != character) return;
+        c.previous_world = c.world;
+        c.velocity_m_s.setZero();
+        c.acceleration_m_s2.setZero();
+        c.angular_velocity_rad_s.setZero();
+        c.updates = std::min<std::uint8_t>(c.updates, 1);  // the next step's velocity, but no acceleration from zero
+    });
+}
 
 System make_teleport_guard_system(double threshold_m, std::shared_ptr<TeleportLog> log) {
     struct Last {
@@ -39,13 +51,7 @@ System make_teleport_guard_system(double threshold_m, std::shared_ptr<TeleportLo
         for (Entity character : jumped) {
             ++log->teleports;
             // The jump is no motion: the colliders must not carry its velocity into the cloth.
-            registry.view<EllipsoidCollider>().each([&](Entity, EllipsoidCollider& c) {
-                if (c.character != character) return;
-                c.previous_world = c.world;
-                c.velocity_m_s.setZero();
-                c.acceleration_m_s2.setZero();
-                c.angular_velocity_rad_s.setZero();
-            });
+            forget_collider_motion(registry, character);
             std::vector<Entity> worn;
             registry.view<Garment>().each([&](Entity g, Garment& garment) {
                 if (garment.body.character == character) worn.push_back(g);

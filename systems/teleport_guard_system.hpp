@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "drape/engine/core/registry.hpp"
 #include "drape/engine/core/scheduler.hpp"
 
 namespace drape {
@@ -23,6 +24,12 @@ struct TeleportLog {
     std::uint64_t teleports = 0;     ///< Jumps detected.
     std::uint64_t resets = 0;        ///< Garments reset because of them (or on request).
 };
+
+/// Forget the motion of a character's colliders: each one's previous pose becomes its pose
+/// and its velocities and accelerations zero, so that a jump of the body (a teleport, a tool
+/// putting the body back) reaches neither the body-driven force model nor a garment reset
+/// after it (reset_garment gives the particles the anchor's velocity).
+void forget_collider_motion(Registry& registry, Entity character);
 
 /// The teleport guard: a root moving more than `threshold_m` within one fixed step counts as
 /// a teleport in `log` and resets the garments the character wears.

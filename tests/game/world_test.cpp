@@ -172,6 +172,16 @@ TEST(TeleportGuard, JumpResetsTheGarmentAroundTheBodyAtItsNewPlace) {
     EXPECT_NEAR(mean_position(g).x(), 5.0f, 0.3f);
     // The jump carried no velocity into the cloth.
     EXPECT_LT(g.state.v.colwise().norm().maxCoeff(), 5.0f);
+    // Nor into the next step's colliders: they move with the clip again, and no acceleration
+    // is taken from the velocity the guard forgot (it would be the clip's velocity over one
+    // step, hundreds of m/s^2 at a foot).
+    ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    double fastest = 0;
+    world->registry.view<EllipsoidCollider>().each([&](Entity, const EllipsoidCollider& c) {
+        fastest = std::max(fastest, static_cast<double>(c.velocity_m_s.norm()));
+        EXPECT_EQ(c.acceleration_m_s2, Vec3::Zero());
+    });
+    EXPECT_GT(fastest, 0.1);
     for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
     expect_never_nonfinite(*world);
     EXPECT_NEAR(mean_position(world->registry.get<Garment>(world->garments[0])).x(), 5.0f, 0.3f);
