@@ -256,6 +256,8 @@ nlohmann::json row_json(const RunResult& r) {
     j["repair_rounds_max"] = r.stats.repair_rounds_max;
     j["budget_hits"] = r.stats.budget_hits;
     j["collision_tests_per_frame"] = r.stats.collision_tests_per_frame;
+    j["substeps_mean"] = r.stats.substeps_mean;
+    j["substeps_max"] = r.stats.substeps_max;
     j["worst_spring"] = worst_spring_json(r.stats.worst_spring);
     j["within_contract"] = r.within_contract();
     j["cost_bounded"] = r.cost_bounded();

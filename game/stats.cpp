@@ -70,6 +70,8 @@ void GarmentWatch::sample(const Registry& registry) {
         worse(w.rise_above_pins_m, q.rise_above_pins_m);
         if (std::isnan(q.compression_min) || q.compression_min < w.compression_min) w.compression_min = q.compression_min;
         w.repair_rounds_max = std::max(w.repair_rounds_max, g->counters.frame_repair_rounds);
+        w.substeps_max = std::max(w.substeps_max, g->counters.substeps);
+        t.substeps_sum += static_cast<std::uint64_t>(std::max(g->counters.substeps, 0));
         worse(w.penetration_before_response_m, g->counters.max_penetration_m);
         w.nonfinite += q.nonfinite;
         if (m_skin_every > 0 && (m_frames - 1) % static_cast<std::uint64_t>(m_skin_every) == 0) {
@@ -109,8 +111,10 @@ std::vector<GarmentStats> GarmentWatch::result(const Registry& registry) const {
             s.nonfinite += g->counters.non_finite_values;
             s.resets = g->counters.resets - t.resets_at_start;
             s.budget_hits = g->counters.budget_hits - t.budget_hits_at_start;
-            if (m_frames > 0)
+            if (m_frames > 0) {
                 s.collision_tests_per_frame = double(g->counters.collision_tests - t.tests_at_start) / double(m_frames);
+                s.substeps_mean = double(t.substeps_sum) / double(m_frames);
+            }
         }
         out.push_back(s);
     }
@@ -179,6 +183,8 @@ std::string stats_json(const RunStats& stats) {
                             {"collision_tests_per_frame", number(g.collision_tests_per_frame)},
                             {"repair_rounds_max", g.repair_rounds_max},
                             {"budget_hits", g.budget_hits},
+                            {"substeps_mean", number(g.substeps_mean)},
+                            {"substeps_max", g.substeps_max},
                             {"max_strain", number(g.strain_max)},
                             {"max_penetration_m", number(g.penetration_before_response_m)}});
     Json j = {{"frames", stats.frames},          {"sim_dt_s", number(stats.sim_dt_s)}, {"characters", std::move(characters)},

@@ -85,6 +85,8 @@ struct GarmentStats {
     double collision_tests_per_frame = 0;///< Particle-ellipsoid tests per rendered frame, mean.
     int repair_rounds_max = 0;           ///< Most contact repair rounds in one frame.
     std::uint64_t budget_hits = 0;       ///< Substeps whose contact repair ran out of its round budget.
+    double substeps_mean = 0;            ///< Substeps of the frame's last fixed step, mean over the frames.
+    int substeps_max = 0;                ///< ... and the most.
     WorstSpring worst_spring = {};       ///< Where the spring of strain_max was.
 };
 
@@ -126,6 +128,7 @@ private:
         GarmentStats worst;
         std::shared_ptr<StrainHistogram> strains = std::make_shared<StrainHistogram>();
         std::uint64_t tests_at_start = 0, resets_at_start = 0, budget_hits_at_start = 0;
+        std::uint64_t substeps_sum = 0;
         std::vector<std::uint64_t> skin_depths;  ///< Histogram of depths behind the skin (skin_bin_m bins; the last: beyond).
         std::uint64_t skin_free = 0, skin_behind = 0;
         bool skin_measured = false;

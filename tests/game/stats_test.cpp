@@ -48,6 +48,8 @@ RunStats example() {
     r.garments.back().pinned_strain_max = 0.3;
     r.garments.back().repair_rounds_max = 7;
     r.garments.back().budget_hits = 3;
+    r.garments.back().substeps_mean = 1.5;
+    r.garments.back().substeps_max = 4;
     r.garments.back().skin_measured = true;
     r.garments.back().skin_penetration_p99_m = 0.004;
     r.garments.back().skin_penetration_max_m = 0.006;
@@ -79,8 +81,10 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     EXPECT_EQ(keys(g), (std::vector<std::string>{"budget_hits", "collision_tests_per_frame", "compression_min",
                                                  "max_penetration_m", "max_strain", "nonfinite", "particles", "penetration_m",
                                                  "pins_inside_m", "repair_rounds_max", "resets", "rise_above_pins_m",
-                                                 "skin_penetration_m", "strain"}));
+                                                 "skin_penetration_m", "strain", "substeps_max", "substeps_mean"}));
     EXPECT_DOUBLE_EQ(g["compression_min"].get<double>(), 0.8);
+    EXPECT_DOUBLE_EQ(g["substeps_mean"].get<double>(), 1.5);
+    EXPECT_EQ(g["substeps_max"], 4);
     EXPECT_EQ(g["repair_rounds_max"], 7);
     EXPECT_EQ(g["budget_hits"], 3);
     EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99", "pinned_max", "worst"}));
@@ -146,11 +150,13 @@ TEST(GarmentWatch, ReportsWorstValuesAfterEachFrameAndNonFiniteParticles) {
     const Real rest = (g.state.x.col(hem) - g.state.x.col(above)).norm();
     g.state.x.col(hem) = g.state.x.col(above) + (g.state.x.col(hem) - g.state.x.col(above)) * Real(1.2);
     g.counters.max_penetration_m = 0.01f;
+    g.counters.substeps = 3;
     watch.sample(registry);
-    // Frame 2: back to rest, fewer found, a NaN.
+    // Frame 2: back to rest, fewer found, a NaN, one substep.
     g.state.x.col(hem) = g.state.x.col(above) + (g.state.x.col(hem) - g.state.x.col(above)).normalized() * rest;
     g.counters.collision_tests = 400;
     g.counters.max_penetration_m = 0.002f;
+    g.counters.substeps = 1;
     g.state.x(1, t.grid[5]) = std::numeric_limits<Real>::quiet_NaN();
     watch.sample(registry);
 
@@ -161,6 +167,8 @@ TEST(GarmentWatch, ReportsWorstValuesAfterEachFrameAndNonFiniteParticles) {
     EXPECT_NEAR(result[0].penetration_before_response_m, 0.01, 1e-6);
     EXPECT_EQ(result[0].nonfinite, 1u);
     EXPECT_DOUBLE_EQ(result[0].collision_tests_per_frame, 150.0);  // (400 - 100) tests over 2 frames
+    EXPECT_DOUBLE_EQ(result[0].substeps_mean, 2.0);
+    EXPECT_EQ(result[0].substeps_max, 3);
 }
 
 TEST(GarmentWatch, StrainIsMeasuredOnTheGarmentAfterTheFrame) {
