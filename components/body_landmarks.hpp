@@ -53,7 +53,7 @@ struct BodyLandmarks {
     std::vector<int> body_bones;   ///< Bones whose skin is body.
 
     Real crotch_m = 0;             ///< Lowest height where the pelvis's skin crosses the midplane.
-    Real underarm_m = 0;           ///< Mean height of the armpits.
+    Real underarm_m = 0;           ///< Height under the arms: the higher armpit.
     /// The waist's centre raised to where the arms' skin (by its weights) reaches lowest on
     /// the trunk: at or under the armpits; the built-in dress is held just under it.
     BodyPoint arms_meet_trunk;

@@ -494,7 +494,10 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         armpit_side = gap_side;
         armpits_on_skin = 2;
     }
-    out.underarm_m = Real(0.5) * (armpit[0] + armpit[1]);
+    // The higher armpit: an arm modelled against the trunk parts from it lower than the
+    // armpit on its side (Male_Casual's and Male_LongSleeve's 5.7 cm lower than the other
+    // side), never higher, and a body's two armpits are at one height.
+    out.underarm_m = std::max(armpit[0], armpit[1]);
     // Shoulders: the upper arm's head, the first joint of the arm's chain (from the trunk
     // out) above its armpit and as far out as the trunk's side there (a clavicle's joint by
     // the neck is not); else the chain's first joint.
@@ -577,8 +580,8 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         {"chest", !chest.valid ? "the waist's (no section above it)"
                   : armpits_on_skin == 2 ? "the section of the trunk (and the arms' first bones between the armpits) reaching farthest forward between waist and armpits"
                                          : "the trunk section reaching farthest forward between waist and armpits"},
-        {"under the arms", armpits_by_shape ? "where the skin's section across the body parts into trunk and arm, scanning down from the shoulders, both sides"
-                           : armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk, both sides"
+        {"under the arms", armpits_by_shape ? "where the skin's section across the body parts into trunk and arm, scanning down from the shoulders; the higher side"
+                           : armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk; the higher side"
                            : armpits_on_skin == 1 ? "one side's lowest arm skin shared with the trunk; the other 6 % of the height under its shoulder joint"
                                                   : "6 % of the height under the shoulder joints (arms and trunk are separate pieces)"},
         {"shoulders", (armpits_by_shape ? "the upper arms' heads: the first joint above each armpit and out to the trunk's side, of the two chains reaching farthest sideways from spine bone "

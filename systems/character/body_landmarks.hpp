@@ -24,7 +24,8 @@
 //    on that side parts into the trunk's piece and an arm's beyond it (pieces within 0.1 %
 //    of the height joined); else the lowest skin point of an arm chain on a triangle it
 //    shares with the trunk; where the two are separate pieces (a robot), the shoulder joint
-//    less 6 % of the height. underarm = the mean of the two.
+//    less 6 % of the height. underarm = the higher of the two (an arm modelled against
+//    the trunk parts from it lower on its side).
 //  - arms_meet_trunk: the lowest arm skin on a triangle shared with the trunk (by weight),
 //    at or under the armpits; the built-in dress is held under it.
 //  - waist: the narrowest trunk section between 30 % and 80 % of the way from crotch to
