@@ -17,7 +17,7 @@
 
 namespace drape {
 
-/// The limits of the contract (docs/cloth.md, "What the garment looks like").
+/// The limits of the contract (docs/cloth.md, "Quality after a frame").
 struct QualityContract {
     double strain_p99 = 0.10;                 ///< 99th percentile of the structural-spring strain.
     double strain_max = 0.20;                 ///< Largest structural-spring strain.

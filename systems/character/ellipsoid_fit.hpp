@@ -90,7 +90,7 @@ struct FitOptions {
     double bulge_limit_m = 0.02;           ///< Surface standing out of the skin farther than this fails (asks for a split); the p95 bulge target.
     double target_coverage = 0.99;         ///< Share of skin vertices within tolerance_m of the ellipsoids the fit aims for.
     double sample_spacing = 0.016;         ///< Skin samples inside large faces at most this share of the height apart.
-    double min_radius_m = 0.01;            ///< No axis thinner than this (1.25-2 cm measured and not kept: docs/cloth.md, Known limits).
+    double min_radius_m = 0.01;            ///< No axis thinner than this (1.25-2 cm measured and not kept: docs/cloth.md, Tried).
     int max_ellipsoids = 32;               ///< Budget of fitted pieces (the paper's avatar has 15, a garment takes 64), knee spheres on top; 0 = no limit.
     int tight_extra_ellipsoids = 2;        ///< With tight legs the budget grows by this many pieces (the trunk's decide the bulge).
     double leg_reach_m = 0.05;             ///< A hugged leg's ellipsoid may pass its own skin along the leg by this much (< 0: no limit).

@@ -75,7 +75,8 @@ void finish_constraints(Garment& garment, GarmentSolver& solver, const ClothSubs
 /// After finish_constraints: a last collision round (the limits moved particles), then
 /// contact repair: rounds of the limits on the lines and rows where a particle that moved
 /// has a spring over the strain limit (particles the collision pushed weighted as heavy)
-/// and a collision of what they moved, until none has (at most 48 rounds; docs/cloth.md);
+/// and a collision of what they moved, until none has or the fixed step's round budget is spent
+/// (ClothSolverSettings::repair_rounds_per_frame, shared over the substeps left; docs/cloth.md);
 /// then the velocities of the free particles from their move over the substep: the warp limit's
 /// move of the particle below on the line given back (dynamic follow-the-leader), the
 /// push-outs left out; where a particle touched an ellipsoid, no velocity toward it relative
