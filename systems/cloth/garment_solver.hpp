@@ -72,6 +72,7 @@ struct PartScratch {
     std::vector<std::uint32_t> collide;      ///< Repair: the moved particles of its lines, collided again.
     std::vector<std::uint64_t> crushed;      ///< Repair: springs under the compression limit its particles found (a << 32 | b, a < b).
     std::vector<std::uint64_t> touched;      ///< Per particle of `collide`: its last_collided before that collision.
+    std::vector<std::uint64_t> marks;        ///< Repair: a bit per particle, all clear between uses (sort_unique_below).
 };
 
 struct GarmentSolver {
@@ -133,6 +134,7 @@ struct GarmentSolver {
     VectorX repair_slack_m;                  ///< Per particle collided in a repair round: how far its list still holds from where it is.
     std::vector<std::vector<std::uint32_t>> pushed; ///< Per part: particles the last collision after the limits pushed.
     std::vector<std::uint32_t> repair_rows, repair_lines; ///< The repair rounds' choices, all parts'.
+    std::vector<std::uint64_t> repair_marks; ///< A bit per row or line, all clear between uses (sort_unique_below).
     std::vector<std::uint64_t> repair_crushed; ///< The repair rounds' springs under the compression limit, all parts'.
     std::vector<PartScratch> part_scratch;   ///< Per part.
     std::vector<std::uint32_t> weft_row_work; ///< Per weft row: springs the weft limit corrected in it last substep.

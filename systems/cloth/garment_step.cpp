@@ -459,12 +459,40 @@ void sort_unique(std::vector<T>& list) {
     list.erase(std::unique(list.begin(), list.end()), list.end());
 }
 
+// `list` (values below `universe`) sorted, each entry once, as sort_unique gives it. A long
+// list (a round's moved particles, thousands with repeats, or the rows they chose) is
+// marked in `marks`, a bit per value, and read back in order, in time linear in its length
+// and the universe's words; `marks` is all clear before and after.
+void sort_unique_below(std::vector<std::uint32_t>& list, std::size_t universe, std::vector<std::uint64_t>& marks) {
+    constexpr std::size_t short_list = 64;
+    if (list.size() < short_list || std::any_of(list.begin(), list.end(), [&](std::uint32_t v) { return v >= universe; })) {
+        sort_unique(list);
+        return;
+    }
+    marks.resize((universe + 63) / 64);  // new words are clear
+    for (const std::uint32_t v : list) marks[v >> 6] |= std::uint64_t(1) << (v & 63);
+    list.clear();
+    for (std::size_t w = 0; w < marks.size(); ++w) {
+        for (std::uint64_t bits = marks[w]; bits != 0; bits &= bits - 1)
+            list.push_back(static_cast<std::uint32_t>(w * 64 + static_cast<std::size_t>(std::countr_zero(bits))));
+        marks[w] = 0;
+    }
+}
+
 // The parts' lists in `out`, sorted, each once.
 template <class T>
 void merge_sorted(std::vector<T>& out, const std::vector<PartScratch>& parts, std::vector<T> PartScratch::*list) {
     out.clear();
     for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
     sort_unique(out);
+}
+
+// The same for lists of values below `universe` (rows, lines).
+void merge_sorted_below(std::vector<std::uint32_t>& out, const std::vector<PartScratch>& parts,
+                        std::vector<std::uint32_t> PartScratch::*list, std::size_t universe, std::vector<std::uint64_t>& marks) {
+    out.clear();
+    for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
+    sort_unique_below(out, universe, marks);
 }
 
 // Whether the spring p-q of rest length `rest` is shorter than `shortest` x it, and its key
@@ -614,8 +642,8 @@ void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
             for (const std::uint32_t p : ps.collide) choose(p);
             if (round == 0) find_crushed_lines(f, s, x, s.parts.lines[k], shortest, ps.crushed);
         });
-        merge_sorted(s.repair_rows, s.part_scratch, &PartScratch::rows);
-        merge_sorted(s.repair_lines, s.part_scratch, &PartScratch::lines);
+        merge_sorted_below(s.repair_rows, s.part_scratch, &PartScratch::rows, m, s.repair_marks);
+        merge_sorted_below(s.repair_lines, s.part_scratch, &PartScratch::lines, f.warp_lines, s.repair_marks);
         merge_sorted(s.repair_crushed, s.part_scratch, &PartScratch::crushed);
         if (s.repair_rows.empty() && s.repair_lines.empty() && s.repair_crushed.empty()) return;
         if (round == rounds) {  // the budget binds: springs are left over (or under) the limit
@@ -662,7 +690,7 @@ void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
             for (const PartScratch& other : s.part_scratch)
                 for (const std::uint32_t p : other.moved)
                     if (s.grid_place[p] / m % parts == k) ps.collide.push_back(p);
-            sort_unique(ps.collide);
+            sort_unique_below(ps.collide, static_cast<std::size_t>(x.cols()), ps.marks);
             collide_moved(g, s, k);
         });
     }
