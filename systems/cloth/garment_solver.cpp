@@ -103,11 +103,15 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.tethers = split_tethers(tethers, parts.band, parts.count);
         s.below.resize(static_cast<std::size_t>(n));
         s.above.resize(static_cast<std::size_t>(n));
-        s.grid_place.resize(static_cast<std::size_t>(n));
+        s.grid_line.resize(static_cast<std::size_t>(n));
+        s.grid_row.resize(static_cast<std::size_t>(n));
+        s.repair_part.resize(static_cast<std::size_t>(n));
         const std::uint32_t rows = t.particles_per_line;
         for (std::uint32_t line = 0; line < t.warp_lines; ++line)
             for (std::uint32_t row = 0; row < rows; ++row) {
-                s.grid_place[t.grid[line * rows + row]] = line * rows + row;
+                s.grid_line[t.grid[line * rows + row]] = line;
+                s.grid_row[t.grid[line * rows + row]] = row;
+                s.repair_part[t.grid[line * rows + row]] = static_cast<std::uint32_t>(line % parts.count);
                 s.below[t.grid[line * rows + row]] = t.grid[line * rows + std::min(row + 1, rows - 1)];
                 s.above[t.grid[line * rows + row]] = t.grid[line * rows + (row > 0 ? row - 1 : 0)];
             }

@@ -91,7 +91,9 @@ struct GarmentSolver {
     std::vector<Tethers> tethers;            ///< Long-range attachments from the pins, per line band.
     std::vector<std::uint32_t> below;        ///< Per particle: the particle below it on its line (itself in the last row).
     std::vector<std::uint32_t> above;        ///< Per particle: the particle above it on its line (itself in the first row).
-    std::vector<std::uint32_t> grid_place;   ///< Per particle: line x particles_per_line + row (Fabric::grid's inverse).
+    std::vector<std::uint32_t> grid_line;    ///< Per particle: its line (Fabric::grid's inverse, with grid_row).
+    std::vector<std::uint32_t> grid_row;     ///< Per particle: its row.
+    std::vector<std::uint32_t> repair_part;  ///< Per particle: the part whose repair collision takes it (its line modulo the parts).
     VectorX weft_rest_right;                 ///< Per particle: rest length of the weft spring to the next line.
     VectorX warp_rest_above;                 ///< Per particle: rest length of the warp spring to the particle above it
                                              ///< on its line (0 in the first row).

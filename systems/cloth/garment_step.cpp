@@ -400,7 +400,7 @@ void collide_limit_moves(Garment& g, GarmentSolver& s, std::size_t part, PartCou
 // (to the particle above or below on its line), bit 1 a weft spring (to a neighbouring line).
 int over_limit(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::uint32_t p, Real limit) {
     const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
-    const std::uint32_t line = s.grid_place[p] / m, row = s.grid_place[p] % m;
+    const std::uint32_t line = s.grid_line[p], row = s.grid_row[p];
     const Real scale = 1 + limit;
     const auto over = [&](std::uint32_t q, Real rest) { return (x.col(q) - x.col(p)).squaredNorm() > scale * scale * rest * rest; };
     int springs = 0;
@@ -509,7 +509,7 @@ bool find_crushed(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, st
                   std::vector<std::uint64_t>& out) {
     if (!(shortest > 0)) return false;
     const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
-    const std::uint32_t line = s.grid_place[p] / m, row = s.grid_place[p] % m;
+    const std::uint32_t line = s.grid_line[p], row = s.grid_row[p];
     bool found = false;
     const auto check = [&](std::uint32_t q, Real rest) {
         if (!is_crushed(x, p, q, rest, shortest)) return;
@@ -558,15 +558,15 @@ void find_crushed_lines(const Fabric& f, const GarmentSolver& s, const Matrix3X&
 // `moved`.
 void push_apart(const Fabric& f, const GarmentSolver& s, Matrix3X& x, const VectorX& w, Real target,
                 std::vector<std::uint32_t>& moved) {
-    const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
+    const std::uint32_t n = f.warp_lines;
     for (const std::uint64_t key : s.repair_crushed) {
         const auto a = static_cast<std::uint32_t>(key >> 32), b = static_cast<std::uint32_t>(key);
         const Real wsum = w[a] + w[b];
         if (!(wsum > 0)) continue;
-        const std::uint32_t la = s.grid_place[a] / m, lb = s.grid_place[b] / m;
+        const std::uint32_t la = s.grid_line[a], lb = s.grid_line[b];
         Real rest = 0;
         if (la == lb)
-            rest = s.warp_rest_above[s.grid_place[a] % m > s.grid_place[b] % m ? a : b];
+            rest = s.warp_rest_above[s.grid_row[a] > s.grid_row[b] ? a : b];
         else
             rest = (la + 1) % n == lb ? s.weft_rest_right[a] : s.weft_rest_right[b];
         Vec3 d = x.col(b) - x.col(a);
@@ -632,8 +632,8 @@ void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
             ps.crushed.clear();
             const auto choose = [&](std::uint32_t p) {
                 const int springs = over_limit(f, s, x, p, limit);
-                if (springs & 1) ps.lines.push_back(s.grid_place[p] / m);
-                if (springs & 2) ps.rows.push_back(s.grid_place[p] % m);
+                if (springs & 1) ps.lines.push_back(s.grid_line[p]);
+                if (springs & 2) ps.rows.push_back(s.grid_row[p]);
                 const bool crushed = find_crushed(f, s, x, p, shortest, ps.crushed);
                 return springs != 0 || crushed;
             };
@@ -689,7 +689,7 @@ void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
             ps.collide.clear();
             for (const PartScratch& other : s.part_scratch)
                 for (const std::uint32_t p : other.moved)
-                    if (s.grid_place[p] / m % parts == k) ps.collide.push_back(p);
+                    if (s.repair_part[p] == k) ps.collide.push_back(p);
             sort_unique_below(ps.collide, static_cast<std::size_t>(x.cols()), ps.marks);
             collide_moved(g, s, k);
         });
