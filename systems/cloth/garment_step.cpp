@@ -479,20 +479,11 @@ void sort_unique_below(std::vector<std::uint32_t>& list, std::size_t universe, s
     }
 }
 
-// The parts' lists in `out`, sorted, each once.
+// The parts' lists in `out`, one after the other (the caller sorts them).
 template <class T>
-void merge_sorted(std::vector<T>& out, const std::vector<PartScratch>& parts, std::vector<T> PartScratch::*list) {
+void gather(std::vector<T>& out, const std::vector<PartScratch>& parts, std::vector<T> PartScratch::*list) {
     out.clear();
     for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
-    sort_unique(out);
-}
-
-// The same for lists of values below `universe` (rows, lines).
-void merge_sorted_below(std::vector<std::uint32_t>& out, const std::vector<PartScratch>& parts,
-                        std::vector<std::uint32_t> PartScratch::*list, std::size_t universe, std::vector<std::uint64_t>& marks) {
-    out.clear();
-    for (const PartScratch& p : parts) out.insert(out.end(), (p.*list).begin(), (p.*list).end());
-    sort_unique_below(out, universe, marks);
 }
 
 // Whether the spring p-q of rest length `rest` is shorter than `shortest` x it, and its key
@@ -642,9 +633,12 @@ void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
             for (const std::uint32_t p : ps.collide) choose(p);
             if (round == 0) find_crushed_lines(f, s, x, s.parts.lines[k], shortest, ps.crushed);
         });
-        merge_sorted_below(s.repair_rows, s.part_scratch, &PartScratch::rows, m, s.repair_marks);
-        merge_sorted_below(s.repair_lines, s.part_scratch, &PartScratch::lines, f.warp_lines, s.repair_marks);
-        merge_sorted(s.repair_crushed, s.part_scratch, &PartScratch::crushed);
+        gather(s.repair_rows, s.part_scratch, &PartScratch::rows);
+        sort_unique_below(s.repair_rows, m, s.repair_marks);
+        gather(s.repair_lines, s.part_scratch, &PartScratch::lines);
+        sort_unique_below(s.repair_lines, f.warp_lines, s.repair_marks);
+        gather(s.repair_crushed, s.part_scratch, &PartScratch::crushed);
+        sort_unique(s.repair_crushed);
         if (s.repair_rows.empty() && s.repair_lines.empty() && s.repair_crushed.empty()) return;
         if (round == rounds) {  // the budget binds: springs are left over (or under) the limit
             ++g.counters.budget_hits;
