@@ -195,12 +195,17 @@ Result<void> run_case(World& world, const ClothMaterial& material, const PinReac
     auto& transform = r.get<Transform>(character);
     auto& player = r.get<AnimationPlayer>(character);
     const Transform home = transform;
-    // The body back where the last case left it (home, playing) for one step, so that its
-    // colliders are there too; that jump home is no motion (a spin's last case ends half a
-    // turn away: its colliders would carry hundreds of rad/s into the garment's reset), so
-    // their motion is forgotten, as after a teleport; then the garment at rest around it.
+    // The body back home at the clip's start (playing) for one step, so that its colliders
+    // are there too, and a case gives the same result whichever cases ran before it (the
+    // clip went on from where the last case left it: a spin at 1e4 N/m diverged after the
+    // softer spins and not alone); that jump home is no motion (a spin's last case ends
+    // half a turn away: its colliders would carry hundreds of rad/s into the garment's
+    // reset), so their motion is forgotten, as after a teleport; then the garment at rest
+    // around it.
     player.speed = 1;
     player.playing = true;
+    player.time_s = 0;
+    player.cycles = 0;
     if (auto ok = step_world(world, c.frame_dt_s); !ok) return fail(ok.error().message);
     forget_collider_motion(r, character);
     if (auto ok = set_garment_material(r, world.garments.at(0), material); !ok) return fail(ok.error().message);
