@@ -49,6 +49,7 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     if (threads_set) c += " --threads " + std::to_string(threads);
     if (!o.filter.empty()) c += " --filter '" + o.filter + "'";
     for (const auto& [name, value] : o.garment_parameters) c += " --garment-param " + name + "=" + parameter_number_text(value);
+    if (o.start_s > 0) c += " --start " + parameter_number_text(o.start_s);
     return c;
 }
 
@@ -102,6 +103,7 @@ void add_bench_command(CLI::App& app) {
         bool overwrite = false;
         std::string filter;
         std::vector<std::string> garment_params;
+        double start_s = 0;
     };
     auto cli = std::make_shared<Cli>();
     std::string names;
@@ -118,6 +120,8 @@ void add_bench_command(CLI::App& app) {
     command->add_option("--garment-param", cli->garment_params,
                         "NAME=VALUE: a garment parameter (docs/scenes.md) for every garment instead of the shipped value (motions); "
                         "repeatable");
+    command->add_option("--start", cli->start_s, "Seconds into the clip where every case starts (stability; default 0)")
+        ->check(CLI::Range(0.0, 1000.0));
     command->add_flag("--overwrite", cli->overwrite, "Replace an existing --json file or a NAME.md this command did not write");
     command->footer("Benchmarks: " + names + ". Each writes NAME.md and NAME*.png in the output folder "
                     "and never asserts a timing; it fails only when it cannot run.");
@@ -148,6 +152,11 @@ void add_bench_command(CLI::App& app) {
             command_exit_code() = exit_bad_input;
             return;
         }
+        if (cli->start_s > 0 && cli->name != "stability") {
+            std::fprintf(stderr, "drape bench: --start: only the stability benchmark takes it\n");
+            command_exit_code() = exit_bad_input;
+            return;
+        }
         const bool runs_set = command->count("--runs") > 0;
         const bool threads_set = command->count("--threads") > 0;
         // --threads caps every world (tbb::global_control); without it each benchmark sets
@@ -165,6 +174,7 @@ void add_bench_command(CLI::App& app) {
             options.threads = cli->threads;
             options.filter = cli->filter;
             options.garment_parameters = garment_parameters;
+            options.start_s = cli->start_s;
             if (!cli->json.empty())
                 options.json = cli->name == "all" ? std::filesystem::path(cli->json) / (b->name + ".json")
                                                   : std::filesystem::path(cli->json);

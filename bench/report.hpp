@@ -32,6 +32,8 @@ struct BenchOptions {
     /// Garment parameters (docs/scenes.md's table: name, value) given to every garment of the
     /// runs instead of the shipped values (`--garment-param NAME=VALUE`; motions only).
     std::vector<std::pair<std::string, double>> garment_parameters;
+    /// Where in its clip every case starts, s (`--start`; stability only).
+    double start_s = 0;
 };
 
 /// The machine and conditions a report was measured under.

@@ -189,22 +189,22 @@ double garment_mass_kg(const Garment& g) {
 }
 
 /// Runs one case on a world built for its garment and step.
-Result<void> run_case(World& world, const ClothMaterial& material, const PinReach& reach, Case& c) {
+Result<void> run_case(World& world, const ClothMaterial& material, const PinReach& reach, double start_s, Case& c) {
     Registry& r = world.registry;
     const Entity character = world.characters.at(0);
     auto& transform = r.get<Transform>(character);
     auto& player = r.get<AnimationPlayer>(character);
     const Transform home = transform;
-    // The body back home at the clip's start (playing) for one step, so that its colliders
-    // are there too, and a case gives the same result whichever cases ran before it (the
-    // clip went on from where the last case left it: a spin at 1e4 N/m diverged after the
-    // softer spins and not alone); that jump home is no motion (a spin's last case ends
-    // half a turn away: its colliders would carry hundreds of rad/s into the garment's
-    // reset), so their motion is forgotten, as after a teleport; then the garment at rest
-    // around it.
+    // The body back home at `start_s` into its clip (playing) for one step, so that its
+    // colliders are there too, and a case gives the same result whichever cases ran before
+    // it (the clip went on from where the last case left it: a spin at 1e4 N/m diverged
+    // after the softer spins and not alone); that jump home is no motion (a spin's last
+    // case ends half a turn away: its colliders would carry hundreds of rad/s into the
+    // garment's reset), so their motion is forgotten, as after a teleport; then the garment
+    // at rest around it.
     player.speed = 1;
     player.playing = true;
-    player.time_s = 0;
+    player.time_s = start_s;
     player.cycles = 0;
     if (auto ok = step_world(world, c.frame_dt_s); !ok) return fail(ok.error().message);
     forget_collider_motion(r, character);
@@ -432,7 +432,7 @@ Result<void> run_stability(const BenchOptions& options) {
                                  k_label(c.k_N_m) + (c.default_material ? " (shipped)" : "") + "/dt=" + step_label(dt) +
                                  (automatic ? "/auto" : "/1-substep");
                         if (!matches_filter(c.name, options.filter)) continue;
-                        if (auto ok = run_case(*world, material, reach, c); !ok)
+                        if (auto ok = run_case(*world, material, reach, options.start_s, c); !ok)
                             return fail("stability: " + c.name + ": " + ok.error().message);
                         cases.push_back(c);
                     }
@@ -551,7 +551,7 @@ Result<void> run_stability(const BenchOptions& options) {
         "run (the walk clip at 2.5x speed); spin (turned at 30 rad/s about the vertical); teleport (moved 100 m at a "
         "third of the run); 10x time scale; sudden stop (carried forward at 5 m/s, then stopped dead with the "
         "animation paused at a third of the run). Each case runs max(" + std::to_string(min_frames) + " steps, " +
-        fixed(run_s, 2) + " s).");
+        fixed(run_s, 2) + " s) from " + fixed(options.start_s, 2) + " s into the walk (`--start`), the same whichever cases ran before it.");
     report.paragraph(
         "**Divergence** (bench/stability_bench.hpp): a non-finite value (the cloth resets such a garment and counts "
         "it); a particle farther from its pin (the nearest along the springs) than " + fixed(1 + base_limits.reach_factor, 1) +

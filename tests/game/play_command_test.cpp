@@ -153,6 +153,7 @@ TEST_F(PlayCommand, BenchGarmentParametersAreCheckedByName) {
         {"bench motions --garment-param inertia_linear",
          "drape bench: --garment-param 'inertia_linear': give NAME=VALUE (drape scene-parameters lists the names)\n"},
         {"bench quality --garment-param inertia_linear=0.5", "drape bench: --garment-param: only the motions benchmark takes it\n"},
+        {"bench motions --start 0.5", "drape bench: --start: only the stability benchmark takes it\n"},
     };
     for (const Case& c : cases) {
         const PlayRun run = drape(c.args, m_dir);
