@@ -124,6 +124,8 @@ struct ClothMaterial {
     Real strain_limit = Real(0.10);         ///< Provot: max relative over-stretch (method §4.1).
     Real compression_limit = Real(0.25);    ///< Shortest a spring may be, over its rest length (0: none).
     int iterations = 4;                     ///< Constraint rounds per substep.
+    int line_iterations = 8;                ///< WarpSolve::lines: most Newton steps per line solve (round).
+    Real line_tolerance = Real(0.001);      ///< WarpSolve::lines: a spring's residual strain that ends them.
     Real candidate_margin_m = Real(0.08);   ///< Candidate lists: reach beyond the surface (method §5).
     friend bool operator==(const ClothMaterial&, const ClothMaterial&) = default;
 };
@@ -210,6 +212,7 @@ struct GarmentCounters {
     std::uint64_t list_rebuilds = 0;
     std::uint64_t list_rebuild_tests = 0;
     std::uint64_t repair_rounds = 0;          ///< Contact repair rounds run (limits and collision after the last collision).
+    std::uint64_t line_steps = 0;             ///< WarpSolve::lines: Newton steps of the line solves, summed over sets and bands.
     int frame_repair_rounds = 0;              ///< Contact repair rounds in the last fixed step (all substeps).
     std::uint64_t budget_hits = 0;            ///< Substeps whose contact repair stopped at its round budget with springs still over the limit.
     std::uint64_t non_finite_values = 0;      ///< Non-finite coordinates found (then the garment was reset).

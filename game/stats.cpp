@@ -20,6 +20,7 @@ GarmentWatch::GarmentWatch(const Registry& registry, std::vector<Entity> garment
         Track t;
         t.entity = e;
         t.tests_at_start = g ? g->counters.collision_tests : 0;
+        t.line_steps_at_start = g ? g->counters.line_steps : 0;
         t.resets_at_start = g ? g->counters.resets : 0;
         t.budget_hits_at_start = g ? g->counters.budget_hits : 0;
         if (m_skin_every > 0) t.skin_depths.assign(skin_bins, 0);
@@ -113,6 +114,7 @@ std::vector<GarmentStats> GarmentWatch::result(const Registry& registry) const {
             s.budget_hits = g->counters.budget_hits - t.budget_hits_at_start;
             if (m_frames > 0) {
                 s.collision_tests_per_frame = double(g->counters.collision_tests - t.tests_at_start) / double(m_frames);
+                s.line_steps_per_frame = double(g->counters.line_steps - t.line_steps_at_start) / double(m_frames);
                 s.substeps_mean = double(t.substeps_sum) / double(m_frames);
             }
         }
@@ -181,6 +183,7 @@ std::string stats_json(const RunStats& stats) {
                             {"nonfinite", g.nonfinite},
                             {"resets", g.resets},
                             {"collision_tests_per_frame", number(g.collision_tests_per_frame)},
+                            {"line_steps_per_frame", number(g.line_steps_per_frame)},
                             {"repair_rounds_max", g.repair_rounds_max},
                             {"budget_hits", g.budget_hits},
                             {"substeps_mean", number(g.substeps_mean)},

@@ -11,7 +11,8 @@
 //                                    "below_ground_max"},
 //                  "skin_penetration_m": {"p99", "max", "share"},
 //                  "pins_inside_m", "rise_above_pins_m", "nonfinite", "resets",
-//                  "collision_tests_per_frame", "max_strain", "max_penetration_m"}]}
+//                  "collision_tests_per_frame", "line_steps_per_frame", "max_strain",
+//                  "max_penetration_m"}]}
 //
 // `sim_dt_s` is the fixed simulation step. Garment figures are measured after every whole
 // frame (systems/cloth/garment_quality.hpp) and are the worst seen over the run, except
@@ -83,6 +84,7 @@ struct GarmentStats {
     std::uint64_t nonfinite = 0;         ///< Non-finite values the cloth found and reset, plus any left in x or v.
     std::uint64_t resets = 0;            ///< Garment resets during the run (non-finite state, teleports, requests).
     double collision_tests_per_frame = 0;///< Particle-ellipsoid tests per rendered frame, mean.
+    double line_steps_per_frame = 0;     ///< Newton steps of the warp line solves per rendered frame, mean (0: rounds).
     int repair_rounds_max = 0;           ///< Most contact repair rounds in one frame.
     std::uint64_t budget_hits = 0;       ///< Substeps whose contact repair ran out of its round budget.
     double substeps_mean = 0;            ///< Substeps of the frame's last fixed step, mean over the frames.
@@ -127,7 +129,7 @@ private:
         Entity entity;
         GarmentStats worst;
         std::shared_ptr<StrainHistogram> strains = std::make_shared<StrainHistogram>();
-        std::uint64_t tests_at_start = 0, resets_at_start = 0, budget_hits_at_start = 0;
+        std::uint64_t tests_at_start = 0, resets_at_start = 0, budget_hits_at_start = 0, line_steps_at_start = 0;
         std::uint64_t substeps_sum = 0;
         std::vector<std::uint64_t> skin_depths;  ///< Histogram of depths behind the skin (skin_bin_m bins; the last: beyond).
         std::uint64_t skin_free = 0, skin_behind = 0;

@@ -233,13 +233,16 @@ bool line_chains(SpringSet& set) {
 namespace {
 
 // solve_lines' first sweep over one strip: each spring's direction, diagonal
-// w_a + w_b + alpha~ and right-hand side -C - alpha~ lambda.
+// w_a + w_b + alpha~ and right-hand side -C - alpha~ lambda, and the largest right-hand
+// side over its rest length (what is left of the spring's solution, as a strain).
 template <int Stride>
 void line_strip_terms(std::uint32_t count, const Real* __restrict a0, const Real* __restrict a1, const Real* __restrict a2,
                       const Real* __restrict b0, const Real* __restrict b1, const Real* __restrict b2,
                       const Real* __restrict wa, const Real* __restrict wb, const Real* __restrict rest,
                       const Real* __restrict compliance, const Real* __restrict lambda, Real inv_h2, Real* __restrict u0,
-                      Real* __restrict u1, Real* __restrict u2, Real* __restrict pivot, Real* __restrict rhs) {
+                      Real* __restrict u1, Real* __restrict u2, Real* __restrict pivot, Real* __restrict rhs,
+                      Real& largest_residual) {
+    Real largest = largest_residual;
 #pragma GCC ivdep
     for (int k = 0; k < int(count); ++k) {
         const int i = k * Stride;
@@ -252,7 +255,9 @@ void line_strip_terms(std::uint32_t count, const Real* __restrict a0, const Real
         const Real alpha = compliance[i] * inv_h2;
         pivot[i] = std::max(wa[i] + wb[i] + alpha, Real(1e-30));
         rhs[i] = rest[i] - length - alpha * lambda[i];
+        largest = std::max(largest, std::abs(rhs[i]) / rest[i]);
     }
+    largest_residual = largest;
 }
 
 // solve_lines' elimination of a strip's coupling with the strip above it, lane by lane:
@@ -293,7 +298,8 @@ void line_strip_moves(std::uint32_t count, Real* __restrict a0, Real* __restrict
 
 }  // namespace
 
-void solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& w_, Real h) {
+int solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& w_, Real h, int max_iterations,
+                Real tolerance) {
     const SpringPhase& sp = *set.springs;
     Real* x0 = x.row(0).data();
     Real* x1 = x.row(1).data();
@@ -316,58 +322,76 @@ void solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const Vector
     const std::vector<std::uint8_t>& aligned_next = set.aligned_next[band];
     // From the pins down, strip by strip (a strip is a row of lines): each spring's terms,
     // then the elimination of its coupling with the spring above it, -w_shared (u_above . u).
-    for (std::size_t j = 0; j < strips.size(); ++j) {
-        const SpringStrip& st = strips[j];
-        const std::uint32_t count = st.count, stride = st.stride, f = st.first, a = st.a, b = st.b;
-        if (stride == 1)
-            line_strip_terms<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, rest + f, compliance + f,
-                                lambda + f, inv_h2, u0 + f, u1 + f, u2 + f, pivot + f, rhs + f);
-        else
-            line_strip_terms<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, rest + f, compliance + f,
-                                lambda + f, inv_h2, u0 + f, u1 + f, u2 + f, pivot + f, rhs + f);
-        if (j > 0 && aligned_prev[j]) {
-            eliminate_strip(int(count), w + a, u0 + strips[j - 1].first, u1 + strips[j - 1].first, u2 + strips[j - 1].first,
-                            pivot + strips[j - 1].first, rhs + strips[j - 1].first, u0 + f, u1 + f, u2 + f, off + f, pivot + f,
-                            rhs + f);
-        } else {
-            for (std::uint32_t k = 0; k < count; ++k) {
-                const std::uint32_t s = f + k * stride, p = prev[s];
-                off[s] = 0;
-                if (p == no_spring) continue;
-                const Real c = -w[a + k * stride] * (u0[p] * u0[s] + u1[p] * u1[s] + u2[p] * u2[s]);
-                const Real q = c / pivot[p];
-                off[s] = c;
-                pivot[s] = std::max(pivot[s] - c * q, Real(1e-30));
-                rhs[s] -= q * rhs[p];
+    // Returns the largest right-hand side over its spring's rest length.
+    auto eliminate = [&]() {
+        Real largest_residual = 0;
+        for (std::size_t j = 0; j < strips.size(); ++j) {
+            const SpringStrip& st = strips[j];
+            const std::uint32_t count = st.count, stride = st.stride, f = st.first, a = st.a, b = st.b;
+            if (stride == 1)
+                line_strip_terms<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, rest + f,
+                                    compliance + f, lambda + f, inv_h2, u0 + f, u1 + f, u2 + f, pivot + f, rhs + f,
+                                    largest_residual);
+            else
+                line_strip_terms<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, rest + f,
+                                    compliance + f, lambda + f, inv_h2, u0 + f, u1 + f, u2 + f, pivot + f, rhs + f,
+                                    largest_residual);
+            if (j > 0 && aligned_prev[j]) {
+                const std::uint32_t above = strips[j - 1].first;
+                eliminate_strip(int(count), w + a, u0 + above, u1 + above, u2 + above, pivot + above, rhs + above, u0 + f,
+                                u1 + f, u2 + f, off + f, pivot + f, rhs + f);
+            } else {
+                for (std::uint32_t k = 0; k < count; ++k) {
+                    const std::uint32_t s = f + k * stride, p = prev[s];
+                    off[s] = 0;
+                    if (p == no_spring) continue;
+                    const Real c = -w[a + k * stride] * (u0[p] * u0[s] + u1[p] * u1[s] + u2[p] * u2[s]);
+                    const Real q = c / pivot[p];
+                    off[s] = c;
+                    pivot[s] = std::max(pivot[s] - c * q, Real(1e-30));
+                    rhs[s] -= q * rhs[p];
+                }
             }
         }
-    }
+        return largest_residual;
+    };
     // From the hem up: each multiplier's change, then its spring's move (the directions and
     // the springs above no longer need the positions).
-    for (std::size_t j = strips.size(); j-- > 0;) {
-        const SpringStrip& st = strips[j];
-        const std::uint32_t count = st.count, stride = st.stride, f = st.first, a = st.a, b = st.b;
-        if (aligned_next[j]) {
-            const int below = int(strips[j + 1].count);
-            Real* __restrict y = rhs + f;
-            const Real* __restrict y_below = rhs + strips[j + 1].first;
-            const Real* __restrict c_below = off + strips[j + 1].first;
-            const Real* __restrict p = pivot + f;
-            for (int k = 0; k < below; ++k) y[k] = (y[k] - c_below[k] * y_below[k]) / p[k];
-            for (int k = below; k < int(count); ++k) y[k] /= p[k];
-        } else {
-            for (std::uint32_t k = 0; k < count; ++k) {
-                const std::uint32_t s = f + k * stride, t = next[s];
-                rhs[s] = (rhs[s] - (t == no_spring ? Real(0) : off[t] * rhs[t])) / pivot[s];
+    auto substitute = [&]() {
+        for (std::size_t j = strips.size(); j-- > 0;) {
+            const SpringStrip& st = strips[j];
+            const std::uint32_t count = st.count, stride = st.stride, f = st.first, a = st.a, b = st.b;
+            if (aligned_next[j]) {
+                const int below = int(strips[j + 1].count);
+                Real* __restrict y = rhs + f;
+                const Real* __restrict y_below = rhs + strips[j + 1].first;
+                const Real* __restrict c_below = off + strips[j + 1].first;
+                const Real* __restrict p = pivot + f;
+                for (int k = 0; k < below; ++k) y[k] = (y[k] - c_below[k] * y_below[k]) / p[k];
+                for (int k = below; k < int(count); ++k) y[k] /= p[k];
+            } else {
+                for (std::uint32_t k = 0; k < count; ++k) {
+                    const std::uint32_t s = f + k * stride, t = next[s];
+                    rhs[s] = (rhs[s] - (t == no_spring ? Real(0) : off[t] * rhs[t])) / pivot[s];
+                }
             }
+            if (stride == 1)
+                line_strip_moves<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, u0 + f, u1 + f,
+                                    u2 + f, rhs + f, lambda + f);
+            else
+                line_strip_moves<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, u0 + f, u1 + f,
+                                    u2 + f, rhs + f, lambda + f);
         }
-        if (stride == 1)
-            line_strip_moves<1>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, u0 + f, u1 + f, u2 + f,
-                                rhs + f, lambda + f);
-        else
-            line_strip_moves<2>(count, x0 + a, x1 + a, x2 + a, x0 + b, x1 + b, x2 + b, w + a, w + b, u0 + f, u1 + f, u2 + f,
-                                rhs + f, lambda + f);
+    };
+    // Newton's iterations on the lines' constraints: the first always taken (one solve a
+    // round), then more while a spring is farther than `tolerance` (a strain) from its
+    // solution, up to `max_iterations`.
+    int iteration = 0;
+    for (; iteration < std::max(max_iterations, 1); ++iteration) {
+        if (eliminate() <= tolerance && iteration > 0) break;
+        substitute();
     }
+    return iteration;
 }
 
 VectorX warp_rest_above(const Fabric& f) {

@@ -81,10 +81,15 @@ bool line_chains(SpringSet& set);
 /// One round over band `band` of a warp set solved along its lines (line_chains; instead
 /// of solve_springs): each line's springs are one chain whose XPBD constraints, linearised
 /// at the current positions, are solved at once, a tridiagonal system per line (Thomas),
-/// so that one round hangs a line at the stretch its modulus gives, however long the line
-/// and stiff the cloth. The multipliers accumulate over the substep's rounds as in
-/// solve_springs. Provot's limit is left to the warp limit after the rounds.
-void solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& inv_mass, Real h_s);
+/// so that a round hangs a line at the stretch its modulus gives, however long the line
+/// and stiff the cloth. The linearisation is a Newton step: a line bent over the hips or
+/// zigzagging needs several, so the solve is repeated at the new positions while a spring's
+/// right-hand side over its rest length exceeds `tolerance`, at most `max_iterations` times
+/// (at least once). The multipliers accumulate over the substep's rounds as in
+/// solve_springs. Provot's limit is left to the warp limit after the rounds. Returns the
+/// Newton steps taken.
+int solve_lines(SpringSet& set, std::size_t band, Matrix3XRows& x, const VectorX& inv_mass, Real h_s,
+                int max_iterations = 1, Real tolerance = 0);
 
 /// Per spring: 1 / k with k = modulus x (area_a + area_b) / (2 rest^2) (components/garment.hpp).
 /// `area` per particle; a modulus of 0 gives a spring without force (limit only).

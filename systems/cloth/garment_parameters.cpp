@@ -158,6 +158,10 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "the shortest a spring may become over its rest length, the cloth's folds being coarser than its grid; 0 = none"),
         integer("iterations", &ClothMaterial::iterations, closed(1, 100),
                 "constraint and collision rounds per substep (Gauss-Seidel)"),
+        integer("line_iterations", &ClothMaterial::line_iterations, closed(1, 100),
+                "warp lines solved directly (`warp_solve` lines): the most Newton steps of each line solve in a round; more are taken while a spring is off its solution by over `line_tolerance`"),
+        real("line_tolerance", &ClothMaterial::line_tolerance, closed(0, 1), "",
+             "warp lines solved directly: the residual strain (a spring's distance from its solution over its rest length) below which a line solve stops"),
         real("candidate_margin_m", &ClothMaterial::candidate_margin_m, open_min(0, 1), "m",
              "candidate lists: reach beyond an ellipsoid's surface (method §5)"),
     };

@@ -116,6 +116,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
                 s.above[t.grid[line * rows + row]] = t.grid[line * rows + (row > 0 ? row - 1 : 0)];
             }
         s.part_counters.assign(parts.count, PartCounters{});
+        s.line_steps.assign(parts.count, 0);
         s.pushed.assign(parts.count, {});
         s.part_scratch.resize(parts.count);
         s.drag_step_s = drag_step_limit_s(s.inv_mass, s.drag_N_s_m, s.integrated);

@@ -141,6 +141,7 @@ struct GarmentSolver {
     std::vector<PartScratch> part_scratch;   ///< Per part.
     std::vector<std::uint32_t> weft_row_work; ///< Per weft row: springs the weft limit corrected in it last substep.
     std::vector<PartCounters> part_counters; ///< Per part: this stage's counts.
+    std::vector<std::uint64_t> line_steps;   ///< Per part: Newton steps of its line solves in the current round.
 };
 
 /// Sizes the scratch arrays and masks for `garment` and drops the caches that depend on a

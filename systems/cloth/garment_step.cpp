@@ -162,13 +162,18 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
             if (set.next.empty())
                 solve_springs(set, k, s.x_rows, s.inv_mass, h, limit);
             else
-                solve_lines(set, k, s.x_rows, s.inv_mass, h);
+                s.line_steps[k] += static_cast<std::uint64_t>(solve_lines(
+                    set, k, s.x_rows, s.inv_mass, h, g.config.material.line_iterations, g.config.material.line_tolerance));
         }
         if (tethers) solve_tethers(s.tethers[k], s.x_rows);
         if (write_back)
             for (const ParticleRun& r : s.parts.runs[k])
                 x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);
     });
+    for (std::uint64_t& steps : s.line_steps) {
+        g.counters.line_steps += steps;
+        steps = 0;
+    }
 }
 
 void collide_round(const Registry&, Garment& g, GarmentSolver& s, const ClothSubstep&, int) {

@@ -22,13 +22,13 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
         EXPECT_LT(spec.range.min, spec.range.max) << spec.name;
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
-    // Every ClothMaterial field a garment carries is a row (10 of them), and so is every
+    // Every ClothMaterial field a garment carries is a row (12 of them), and so is every
     // numeric field of TubeParams (16, the inertia scales with their acceleration and fall
     // bounds, the hem clearance and the line spacing included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
-    EXPECT_EQ(material, 10);
-    EXPECT_EQ(garment_parameters().size(), 28u);
+    EXPECT_EQ(material, 12);
+    EXPECT_EQ(garment_parameters().size(), 30u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {

@@ -50,6 +50,7 @@ RunStats example() {
     r.garments.back().budget_hits = 3;
     r.garments.back().substeps_mean = 1.5;
     r.garments.back().substeps_max = 4;
+    r.garments.back().line_steps_per_frame = 27.5;
     r.garments.back().skin_measured = true;
     r.garments.back().skin_penetration_p99_m = 0.004;
     r.garments.back().skin_penetration_max_m = 0.006;
@@ -79,7 +80,8 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     ASSERT_EQ(j["garments"].size(), 1u);
     const auto& g = j["garments"][0];
     EXPECT_EQ(keys(g), (std::vector<std::string>{"budget_hits", "collision_tests_per_frame", "compression_min",
-                                                 "max_penetration_m", "max_strain", "nonfinite", "particles", "penetration_m",
+                                                 "line_steps_per_frame", "max_penetration_m", "max_strain", "nonfinite",
+                                                 "particles", "penetration_m",
                                                  "pins_inside_m", "repair_rounds_max", "resets", "rise_above_pins_m",
                                                  "skin_penetration_m", "strain", "substeps_max", "substeps_mean"}));
     EXPECT_DOUBLE_EQ(g["compression_min"].get<double>(), 0.8);
@@ -87,6 +89,7 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
     EXPECT_EQ(g["substeps_max"], 4);
     EXPECT_EQ(g["repair_rounds_max"], 7);
     EXPECT_EQ(g["budget_hits"], 3);
+    EXPECT_DOUBLE_EQ(g["line_steps_per_frame"].get<double>(), 27.5);
     EXPECT_EQ(keys(g["strain"]), (std::vector<std::string>{"max", "p99", "pinned_max", "worst"}));
     const auto& worst = g["strain"]["worst"];
     EXPECT_EQ(keys(worst), (std::vector<std::string>{"body_part", "frame", "line", "part_thickness_m", "row", "rows",
