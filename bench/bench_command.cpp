@@ -50,6 +50,7 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     if (!o.filter.empty()) c += " --filter '" + o.filter + "'";
     for (const auto& [name, value] : o.garment_parameters) c += " --garment-param " + name + "=" + parameter_number_text(value);
     if (o.start_s > 0) c += " --start " + parameter_number_text(o.start_s);
+    if (o.warp_solve == WarpSolve::lines) c += " --warp-solve lines";
     return c;
 }
 
@@ -104,6 +105,7 @@ void add_bench_command(CLI::App& app) {
         std::string filter;
         std::vector<std::string> garment_params;
         double start_s = 0;
+        std::string warp_solve;
     };
     auto cli = std::make_shared<Cli>();
     std::string names;
@@ -122,6 +124,9 @@ void add_bench_command(CLI::App& app) {
                         "repeatable");
     command->add_option("--start", cli->start_s, "Seconds into the clip where every case starts (stability; default 0)")
         ->check(CLI::Range(0.0, 1000.0));
+    command->add_option("--warp-solve", cli->warp_solve,
+                        "The shipped solver's warp springs: rounds (default) or lines (motions, stability; docs/cloth.md)")
+        ->check(CLI::IsMember({"rounds", "lines"}));
     command->add_flag("--overwrite", cli->overwrite, "Replace an existing --json file or a NAME.md this command did not write");
     command->footer("Benchmarks: " + names + ". Each writes NAME.md and NAME*.png in the output folder "
                     "and never asserts a timing; it fails only when it cannot run.");
@@ -157,6 +162,11 @@ void add_bench_command(CLI::App& app) {
             command_exit_code() = exit_bad_input;
             return;
         }
+        if (!cli->warp_solve.empty() && cli->name != "motions" && cli->name != "stability") {
+            std::fprintf(stderr, "drape bench: --warp-solve: only the motions and stability benchmarks take it\n");
+            command_exit_code() = exit_bad_input;
+            return;
+        }
         const bool runs_set = command->count("--runs") > 0;
         const bool threads_set = command->count("--threads") > 0;
         // --threads caps every world (tbb::global_control); without it each benchmark sets
@@ -175,6 +185,7 @@ void add_bench_command(CLI::App& app) {
             options.filter = cli->filter;
             options.garment_parameters = garment_parameters;
             options.start_s = cli->start_s;
+            options.warp_solve = cli->warp_solve == "lines" ? WarpSolve::lines : WarpSolve::rounds;
             if (!cli->json.empty())
                 options.json = cli->name == "all" ? std::filesystem::path(cli->json) / (b->name + ".json")
                                                   : std::filesystem::path(cli->json);

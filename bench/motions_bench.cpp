@@ -116,14 +116,16 @@ std::string changed_parameters(const BenchOptions& options) {
     std::string text;
     for (const auto& [name, value] : options.garment_parameters)
         text += (text.empty() ? " but " : ", ") + name + " = " + parameter_number_text(value);
+    if (options.warp_solve == WarpSolve::lines) text += (text.empty() ? " but " : ", ") + std::string("warp lines solved directly");
     return text;
 }
 
 SceneDescription case_scene(const MotionCase& c, int threads,
-                            const std::vector<std::pair<std::string, double>>& garment_parameters) {
+                            const std::vector<std::pair<std::string, double>>& garment_parameters, WarpSolve warp_solve) {
     WorldSpec spec;
     spec.garment = c.garment;
     spec.model = c.model;
+    spec.warp_solve = warp_solve;
     spec.threads = threads;
     SceneDescription scene = scene_for(spec);
     for (const auto& [name, value] : garment_parameters) scene.garments.at(0).parameters.push_back({name, value});
@@ -167,6 +169,7 @@ void drive_root(const MotionCase& c, int frame, int frames, Transform& transform
 struct RunOptions {
     int threads = 1;
     std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.
+    WarpSolve warp_solve = WarpSolve::rounds;                        ///< BenchOptions::warp_solve.
     bool render = false;
     std::vector<int> grab_frames;     ///< Frames to render (with render).
 };
@@ -181,7 +184,7 @@ Result<void> run_case(RunResult& result, const RunOptions& options, std::vector<
     world_options.width = tile_width * render_scale;
     world_options.height = tile_height * render_scale;
 #endif
-    auto world = build_world(case_scene(c, options.threads, options.garment_parameters), world_options);
+    auto world = build_world(case_scene(c, options.threads, options.garment_parameters, options.warp_solve), world_options);
     if (!world) return fail(world.error().message);
     Registry& r = world->registry;
     const Entity character = world->characters.at(0);
@@ -273,6 +276,7 @@ std::string hardest_sheet(const BenchOptions& options, const std::vector<const R
     RunOptions ro;
     ro.threads = options.threads;
     ro.garment_parameters = options.garment_parameters;
+    ro.warp_solve = options.warp_solve;
     ro.render = true;
     for (int k = 0; k < sheet_frames; ++k) ro.grab_frames.push_back((k + 1) * run_frames / sheet_frames - 1);
     for (std::size_t row = 0; row < hardest.size(); ++row) {
@@ -342,6 +346,7 @@ Result<void> run_motions(const BenchOptions& options) {
             RunOptions ro;
             ro.threads = options.threads;
             ro.garment_parameters = options.garment_parameters;
+            ro.warp_solve = options.warp_solve;
             if (auto ok = run_case(result, ro); !ok) result.error = ok.error().message;
             std::fprintf(stderr, "drape bench motions: %s from %.2f s: %s\n", c.name().c_str(), c.start_s,
                          result.within_contract() ? "within the contract" : result.broken().c_str());
@@ -517,7 +522,8 @@ Result<void> run_motions(const BenchOptions& options) {
     nlohmann::json garment_parameters_json = nlohmann::json::object();
     for (const auto& [name, value] : options.garment_parameters) garment_parameters_json[name] = value;
     nlohmann::json json = {{"frames", run_frames}, {"starts", starts}, {"threads", options.threads},
-                           {"filter", options.filter}, {"garment_parameters", garment_parameters_json}, {"runs", rows_json}};
+                           {"filter", options.filter}, {"garment_parameters", garment_parameters_json},
+                           {"warp_solve", options.warp_solve == WarpSolve::lines ? "lines" : "rounds"}, {"runs", rows_json}};
     return finish(report, options, json);
 }
 

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drape/components/garment.hpp"
 #include "drape/engine/core/error.hpp"
 
 namespace drape::bench {
@@ -34,6 +35,9 @@ struct BenchOptions {
     std::vector<std::pair<std::string, double>> garment_parameters;
     /// Where in its clip every case starts, s (`--start`; stability only).
     double start_s = 0;
+    /// How the shipped integrator solves the warp springs (`--warp-solve`; motions and
+    /// stability only).
+    WarpSolve warp_solve = WarpSolve::rounds;
 };
 
 /// The machine and conditions a report was measured under.

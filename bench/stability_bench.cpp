@@ -403,6 +403,7 @@ Result<void> run_stability(const BenchOptions& options) {
                 spec.fixed_dt_s = dt;
                 spec.threads = options.threads;
                 spec.substeps = automatic ? 0 : 1;
+                spec.warp_solve = options.warp_solve;
                 auto world = build_bench_world(spec);
                 if (!world) return fail("stability: " + world.error().message);
                 const Garment& g = first_garment(*world);
@@ -503,6 +504,8 @@ Result<void> run_stability(const BenchOptions& options) {
     for (const Case& c : cases)
         json["cases"].push_back({{"name", c.name},
                                  {"integrator", cloth_integrator_name(c.integrator)},
+                                 {"warp_solve", c.integrator == ClothIntegrator::shipped && options.warp_solve == WarpSolve::lines
+                                                    ? "lines" : "rounds"},
                                  {"garment", garment_type_name(c.garment)},
                                  {"motion", motion_name(c.motion)},
                                  {"auto_substeps", c.auto_substeps},
@@ -551,7 +554,8 @@ Result<void> run_stability(const BenchOptions& options) {
         "run (the walk clip at 2.5x speed); spin (turned at 30 rad/s about the vertical); teleport (moved 100 m at a "
         "third of the run); 10x time scale; sudden stop (carried forward at 5 m/s, then stopped dead with the "
         "animation paused at a third of the run). Each case runs max(" + std::to_string(min_frames) + " steps, " +
-        fixed(run_s, 2) + " s) from " + fixed(options.start_s, 2) + " s into the walk (`--start`), the same whichever cases ran before it.");
+        fixed(run_s, 2) + " s) from " + fixed(options.start_s, 2) + " s into the walk (`--start`), the same whichever cases ran before it." +
+        (options.warp_solve == WarpSolve::lines ? " The shipped integrator's warp lines are solved directly (`--warp-solve lines`)." : ""));
     report.paragraph(
         "**Divergence** (bench/stability_bench.hpp): a non-finite value (the cloth resets such a garment and counts "
         "it); a particle farther from its pin (the nearest along the springs) than " + fixed(1 + base_limits.reach_factor, 1) +

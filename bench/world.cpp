@@ -27,6 +27,7 @@ SceneDescription scene_for(const WorldSpec& spec) {
         g.character = i;
         g.model = spec.model;
         g.integrator = spec.integrator;
+        g.warp_solve = spec.warp_solve;
         g.collision = spec.collision;
         if (spec.particles > 0) g.parameters.push_back({"particles", static_cast<double>(spec.particles)});
         scene.garments.push_back(g);

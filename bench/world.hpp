@@ -17,6 +17,7 @@ struct WorldSpec {
     GarmentType garment = GarmentType::skirt;
     ClothModel model = ClothModel::simplified;
     ClothIntegrator integrator = ClothIntegrator::shipped;
+    WarpSolve warp_solve = WarpSolve::rounds;          ///< The shipped integrator's warp springs.
     CollisionMode collision = CollisionMode::candidate_lists;
     int particles = 0;                                 ///< 0: the builder's default.
     int substeps = 0;                                  ///< 0: the cloth's stability rule.
