@@ -543,10 +543,27 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
     const Real span = arms_skin - crotch;
     const Cut waist = extreme(trunk_and_thighs, crotch + Real(0.3) * span, crotch + Real(0.8) * span, true);
     if (!waist.valid) return fail(at + "the trunk's skin has no section between crotch and armpits");
-    const Cut hips = extreme(trunk, crotch, waist.center.y(), false);
+    // The hips: the fullest section of the trunk with the thighs between crotch and waist;
+    // where the girth is within 1 % of the fullest over a stretch (the thighs' hull bridging
+    // the gap between them just above the crotch), the highest section of that plateau.
+    Cut hips;
+    {
+        constexpr int samples = 24;
+        std::vector<Cut> cuts;
+        Real fullest = 0;
+        for (int i = 0; i <= samples; ++i) {
+            const Cut c = section(rig, indices, trunk_and_thighs, crotch + (waist.center.y() - crotch) * Real(i) / samples, out.left, out.forward);
+            if (!c.valid) continue;
+            cuts.push_back(c);
+            fullest = std::max(fullest, c.girth);
+        }
+        for (const Cut& c : cuts)
+            if (c.girth >= Real(0.98) * fullest) hips = c;
+    }
     // The chest: the trunk, and the skin of the arms' first bones (a clavicle's, over the
     // upper chest) between the armpits, where it is chest, not arm.
     Cut chest;
+    bool chest_flat = false;
     {
         std::vector<char> chest_bones = trunk;
         for (const LimbChain* a : {&out.left_arm, &out.right_arm}) chest_bones[static_cast<std::size_t>(a->root)] = 1;
@@ -554,12 +571,23 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         // The bust or the pectorals: the section whose front reaches farthest forward.
         const auto front = [&](const Cut& k) { return k.center.dot(out.forward) + k.half_depth; };
         constexpr int samples = 24;
+        std::vector<Cut> cuts;
         for (int i = 0; i <= samples; ++i) {
             const Real y = waist.center.y() + (out.underarm_m - waist.center.y()) * Real(i) / samples;
             const Cut c = sides ? section(rig, indices, chest_bones, y, out.left, out.forward, armpit_side[1], armpit_side[0])
                                 : section(rig, indices, trunk, y, out.left, out.forward);
             if (c.valid && (!chest.valid || front(c) > front(chest))) chest = c;
+            if (c.valid) cuts.push_back(c);
         }
+        // A front that stands out nowhere (rising less than 0.25 % of the height from the waist
+        // to the armpits: a shirt hanging straight over the chest) marks no bust line: then
+        // the chest is the fullest of those sections, as a chest girth is taken under the arms.
+        Real lowest_front = std::numeric_limits<Real>::infinity();
+        for (const Cut& c : cuts) lowest_front = std::min(lowest_front, front(c));
+        chest_flat = chest.valid && front(chest) - lowest_front < Real(0.0025) * h;
+        if (chest_flat)
+            for (const Cut& c : cuts)
+                if (c.girth > chest.girth) chest = c;
     }
     out.waist = make_section(waist);
     out.hips = make_section(hips.valid ? hips : waist);
@@ -575,11 +603,14 @@ Result<BodyLandmarks> find_body_landmarks(const CharacterAsset& character) {
         {"crotch", crotch_parted   ? "where the legs part: the lowest skin on the midplane between the thighs, above the knees"
                    : crotch_on_skin ? "the lowest skin of the pelvis bone at the midplane (the legs do not part above the knees)"
                                     : "5 % of the height under the pelvis joint (the legs do not part, no pelvis skin at the midplane)"},
-        {"hips", hips.valid ? "the widest section of the trunk's skin between crotch and waist" : "the waist's (no section below it)"},
+        {"hips", hips.valid ? "the fullest section of the trunk's and thighs' skin between crotch and waist; the highest within 2 % of its girth"
+                            : "the waist's (no section below it)"},
         {"waist", "the narrowest trunk section 30-80 % of the way from the crotch to where the arms' skin weights meet the trunk"},
         {"chest", !chest.valid ? "the waist's (no section above it)"
-                  : armpits_on_skin == 2 ? "the section of the trunk (and the arms' first bones between the armpits) reaching farthest forward between waist and armpits"
-                                         : "the trunk section reaching farthest forward between waist and armpits"},
+                  : std::string(armpits_on_skin == 2 ? "the section of the trunk (and the arms' first bones between the armpits) "
+                                                     : "the trunk section ") +
+                        (chest_flat ? "fullest between waist and armpits (the front is flat to 0.25 % of the height: no bust line)"
+                                    : "reaching farthest forward between waist and armpits")},
         {"under the arms", armpits_by_shape ? "where the skin's section across the body parts into trunk and arm, scanning down from the shoulders; the higher side"
                            : armpits_on_skin == 2 ? "the lowest arm skin on a triangle shared with the trunk; the higher side"
                            : armpits_on_skin == 1 ? "one side's lowest arm skin shared with the trunk; the other 6 % of the height under its shoulder joint"
