@@ -51,6 +51,7 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     for (const auto& [name, value] : o.garment_parameters) c += " --garment-param " + name + "=" + parameter_number_text(value);
     if (o.start_s > 0) c += " --start " + parameter_number_text(o.start_s);
     if (o.warp_solve == WarpSolve::lines) c += " --warp-solve lines";
+    if (o.thicken_thin_trunk_m > 0) c += " --thicken-thin-trunk " + parameter_number_text(o.thicken_thin_trunk_m);
     return c;
 }
 
@@ -106,6 +107,7 @@ void add_bench_command(CLI::App& app) {
         std::vector<std::string> garment_params;
         double start_s = 0;
         std::string warp_solve;
+        double thicken_thin_trunk_m = 0;
     };
     auto cli = std::make_shared<Cli>();
     std::string names;
@@ -127,6 +129,10 @@ void add_bench_command(CLI::App& app) {
     command->add_option("--warp-solve", cli->warp_solve,
                         "The shipped solver's warp springs: rounds (default) or lines (motions, stability; docs/cloth.md)")
         ->check(CLI::IsMember({"rounds", "lines"}));
+    command->add_option("--thicken-thin-trunk", cli->thicken_thin_trunk_m,
+                        "M: the body fit thickens trunk pieces at most M thin inward to the thick ones (motions; default 0: "
+                        "none; docs/cloth.md)")
+        ->check(CLI::Range(0.0, 0.1));
     command->add_flag("--overwrite", cli->overwrite, "Replace an existing --json file or a NAME.md this command did not write");
     command->footer("Benchmarks: " + names + ". Each writes NAME.md and NAME*.png in the output folder "
                     "and never asserts a timing; it fails only when it cannot run.");
@@ -167,6 +173,11 @@ void add_bench_command(CLI::App& app) {
             command_exit_code() = exit_bad_input;
             return;
         }
+        if (cli->thicken_thin_trunk_m > 0 && cli->name != "motions") {
+            std::fprintf(stderr, "drape bench: --thicken-thin-trunk: only the motions benchmark takes it\n");
+            command_exit_code() = exit_bad_input;
+            return;
+        }
         const bool runs_set = command->count("--runs") > 0;
         const bool threads_set = command->count("--threads") > 0;
         // --threads caps every world (tbb::global_control); without it each benchmark sets
@@ -186,6 +197,7 @@ void add_bench_command(CLI::App& app) {
             options.garment_parameters = garment_parameters;
             options.start_s = cli->start_s;
             options.warp_solve = cli->warp_solve == "lines" ? WarpSolve::lines : WarpSolve::rounds;
+            options.thicken_thin_trunk_m = cli->thicken_thin_trunk_m;
             if (!cli->json.empty())
                 options.json = cli->name == "all" ? std::filesystem::path(cli->json) / (b->name + ".json")
                                                   : std::filesystem::path(cli->json);

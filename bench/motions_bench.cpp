@@ -117,18 +117,38 @@ std::string changed_parameters(const BenchOptions& options) {
     for (const auto& [name, value] : options.garment_parameters)
         text += (text.empty() ? " but " : ", ") + name + " = " + parameter_number_text(value);
     if (options.warp_solve == WarpSolve::lines) text += (text.empty() ? " but " : ", ") + std::string("warp lines solved directly");
+    if (options.thicken_thin_trunk_m > 0)
+        text += (text.empty() ? " but " : ", ") + std::string("trunk pieces at most ") + parameter_number_text(options.thicken_thin_trunk_m) +
+                " m thin thickened inward";
     return text;
 }
 
-SceneDescription case_scene(const MotionCase& c, int threads,
-                            const std::vector<std::pair<std::string, double>>& garment_parameters, WarpSolve warp_solve) {
+struct RunOptions {
+    int threads = 1;
+    std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.
+    WarpSolve warp_solve = WarpSolve::rounds;                        ///< BenchOptions::warp_solve.
+    double thicken_thin_trunk_m = 0;                                 ///< BenchOptions::thicken_thin_trunk_m.
+    bool render = false;
+    std::vector<int> grab_frames;     ///< Frames to render (with render).
+};
+
+RunOptions run_options(const BenchOptions& options) {
+    RunOptions ro;
+    ro.threads = options.threads;
+    ro.garment_parameters = options.garment_parameters;
+    ro.warp_solve = options.warp_solve;
+    ro.thicken_thin_trunk_m = options.thicken_thin_trunk_m;
+    return ro;
+}
+
+SceneDescription case_scene(const MotionCase& c, const RunOptions& options) {
     WorldSpec spec;
     spec.garment = c.garment;
     spec.model = c.model;
-    spec.warp_solve = warp_solve;
-    spec.threads = threads;
+    spec.warp_solve = options.warp_solve;
+    spec.threads = options.threads;
     SceneDescription scene = scene_for(spec);
-    for (const auto& [name, value] : garment_parameters) scene.garments.at(0).parameters.push_back({name, value});
+    for (const auto& [name, value] : options.garment_parameters) scene.garments.at(0).parameters.push_back({name, value});
     CharacterDescription& character = scene.characters.at(0);
     if (!c.character->default_avatar) {
         character = CharacterDescription{};
@@ -137,6 +157,7 @@ SceneDescription case_scene(const MotionCase& c, int threads,
     character.clip = c.clip;
     character.in_place = true;
     character.start_s = c.start_s;
+    character.thicken_thin_trunk_m = options.thicken_thin_trunk_m;
     return scene;
 }
 
@@ -166,14 +187,6 @@ void drive_root(const MotionCase& c, int frame, int frames, Transform& transform
     }
 }
 
-struct RunOptions {
-    int threads = 1;
-    std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.
-    WarpSolve warp_solve = WarpSolve::rounds;                        ///< BenchOptions::warp_solve.
-    bool render = false;
-    std::vector<int> grab_frames;     ///< Frames to render (with render).
-};
-
 /// Runs one case; with `render`, returns the grabbed frames too.
 Result<void> run_case(RunResult& result, const RunOptions& options, std::vector<Image>* frames_out = nullptr) {
     const MotionCase& c = result.c;
@@ -184,7 +197,7 @@ Result<void> run_case(RunResult& result, const RunOptions& options, std::vector<
     world_options.width = tile_width * render_scale;
     world_options.height = tile_height * render_scale;
 #endif
-    auto world = build_world(case_scene(c, options.threads, options.garment_parameters, options.warp_solve), world_options);
+    auto world = build_world(case_scene(c, options), world_options);
     if (!world) return fail(world.error().message);
     Registry& r = world->registry;
     const Entity character = world->characters.at(0);
@@ -273,10 +286,7 @@ std::string pct(double x) { return fixed(100 * x, 1) + " %"; }
 std::string hardest_sheet(const BenchOptions& options, const std::vector<const RunResult*>& hardest) {
 #ifdef DRAPE_HAVE_RENDER
     Image sheet = blank_sheet(sheet_frames, static_cast<int>(hardest.size()), tile_width, tile_height);
-    RunOptions ro;
-    ro.threads = options.threads;
-    ro.garment_parameters = options.garment_parameters;
-    ro.warp_solve = options.warp_solve;
+    RunOptions ro = run_options(options);
     ro.render = true;
     for (int k = 0; k < sheet_frames; ++k) ro.grab_frames.push_back((k + 1) * run_frames / sheet_frames - 1);
     for (std::size_t row = 0; row < hardest.size(); ++row) {
@@ -343,11 +353,7 @@ Result<void> run_motions(const BenchOptions& options) {
         for (const MotionCase& c : cases) {
             RunResult result;
             result.c = c;
-            RunOptions ro;
-            ro.threads = options.threads;
-            ro.garment_parameters = options.garment_parameters;
-            ro.warp_solve = options.warp_solve;
-            if (auto ok = run_case(result, ro); !ok) result.error = ok.error().message;
+            if (auto ok = run_case(result, run_options(options)); !ok) result.error = ok.error().message;
             std::fprintf(stderr, "drape bench motions: %s from %.2f s: %s\n", c.name().c_str(), c.start_s,
                          result.within_contract() ? "within the contract" : result.broken().c_str());
             results.push_back(std::move(result));
@@ -523,7 +529,8 @@ Result<void> run_motions(const BenchOptions& options) {
     for (const auto& [name, value] : options.garment_parameters) garment_parameters_json[name] = value;
     nlohmann::json json = {{"frames", run_frames}, {"starts", starts}, {"threads", options.threads},
                            {"filter", options.filter}, {"garment_parameters", garment_parameters_json},
-                           {"warp_solve", options.warp_solve == WarpSolve::lines ? "lines" : "rounds"}, {"runs", rows_json}};
+                           {"warp_solve", options.warp_solve == WarpSolve::lines ? "lines" : "rounds"},
+                           {"thicken_thin_trunk_m", options.thicken_thin_trunk_m}, {"runs", rows_json}};
     return finish(report, options, json);
 }
 

@@ -38,6 +38,9 @@ struct BenchOptions {
     /// How the shipped integrator solves the warp springs (`--warp-solve`; motions and
     /// stability only).
     WarpSolve warp_solve = WarpSolve::rounds;
+    /// The characters' body fit: FitOptions::thicken_thin_trunk_m (`--thicken-thin-trunk`;
+    /// motions only; 0: none, as shipped).
+    double thicken_thin_trunk_m = 0;
 };
 
 /// The machine and conditions a report was measured under.

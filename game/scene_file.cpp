@@ -442,6 +442,7 @@ CharacterDescription read_character(const Reader& r, const std::string& path, co
     if (const Json* v = f.get("in_place")) c.in_place = read_bool(r, f.path("in_place"), *v);
     if (const Json* v = f.get("start_s")) c.start_s = read_real(r, f.path("start_s"), *v, 0, 100000);
     if (const Json* v = f.get("hide_modelled_garments")) c.hide_modelled_garments = read_bool(r, f.path("hide_modelled_garments"), *v);
+    if (const Json* v = f.get("thicken_thin_trunk_m")) c.thicken_thin_trunk_m = read_real(r, f.path("thicken_thin_trunk_m"), *v, 0, 0.1);
     if (const Json* v = f.get("motion")) {
         const std::string motion_path = f.path("motion");
         c.motion = read_string(r, motion_path, *v, false);
@@ -713,6 +714,7 @@ std::string to_json(const SceneDescription& scene) {
         o["in_place"] = c.in_place;
         if (c.start_s != 0) o["start_s"] = c.start_s;
         if (!c.hide_modelled_garments) o["hide_modelled_garments"] = false;
+        if (c.thicken_thin_trunk_m != 0) o["thicken_thin_trunk_m"] = c.thicken_thin_trunk_m;
         if (!c.motion.empty()) o["motion"] = c.motion.string();
         if (!c.motion_bones.empty()) {
             OrderedJson bones = OrderedJson::object();

@@ -139,21 +139,23 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
                                                                    static_cast<std::size_t>(scene.solver.threads));
     world.scheduler.profiler().set_timing(options.profile);
 
-    // Characters (one import and one fitted body per file), then collider overrides.
+    // Characters (one import and one fitted body per file and fit), then collider overrides.
     struct Loaded {
         std::shared_ptr<const CharacterAsset> asset;
         CharacterBody body;
     };
-    std::map<fs::path, Loaded> loaded;
+    std::map<std::pair<fs::path, double>, Loaded> loaded;
     const fs::path body_cache = !options.body_cache.empty() ? options.body_cache : body_cache_from_environment();
     for (std::size_t i = 0; i < scene.characters.size(); ++i) {
         const CharacterDescription& c = scene.characters[i];
         const std::string field = "characters[" + std::to_string(i) + "].file";
-        Loaded& character = loaded[c.file];
+        Loaded& character = loaded[{c.file, c.thicken_thin_trunk_m}];
         if (!character.asset) {
             auto imported = import_character(c.file);
             if (!imported) return fail(located(c.where, field, imported.error().message));
-            auto body = fit_character_body(**imported, c.file, FitOptions{}, body_cache);
+            FitOptions fit_options;
+            fit_options.thicken_thin_trunk_m = c.thicken_thin_trunk_m;
+            auto body = fit_character_body(**imported, c.file, fit_options, body_cache);
             if (!body) return fail(located(c.where, field, body.error().message));
             character = {*imported, std::move(*body)};
             world.warnings.insert(world.warnings.end(), character.asset->warnings.begin(), character.asset->warnings.end());
@@ -244,7 +246,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
                                          [&](const GarmentDescription& g) { return g.character == static_cast<int>(i); });
         auto* skin = world.registry.try_get<SkinnedMesh>(world.characters[i]);
         if (!dressed || !c.hide_modelled_garments || skin == nullptr || !skin->mesh) continue;
-        for (const LeftOutMesh& part : loaded.at(c.file).body.left_out)
+        for (const LeftOutMesh& part : loaded.at({c.file, c.thicken_thin_trunk_m}).body.left_out)
             if (part.garment && part.mesh < skin->mesh->submeshes.size()) {
                 skin->hidden.resize(skin->mesh->submeshes.size(), 0);
                 skin->hidden[part.mesh] = 1;

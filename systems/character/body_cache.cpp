@@ -29,13 +29,13 @@ namespace {
 
 // A new field in any of these must be written and read below (and the format's version
 // raised); the sizes (with Eigen's alignment on x86-64) catch one added without that.
-static_assert(sizeof(FitOptions) == 96, "body_cache.cpp: add the new FitOptions field to the key");
+static_assert(sizeof(FitOptions) == 104, "body_cache.cpp: add the new FitOptions field to the key");
 static_assert(sizeof(EllipsoidShape) == 64, "body_cache.cpp: write and read the new EllipsoidShape field");
 static_assert(sizeof(BodyPoint) == 28, "body_cache.cpp: write and read the new BodyPoint field");
 static_assert(sizeof(BodySection) == 40, "body_cache.cpp: write and read the new BodySection field");
 static_assert(sizeof(BodyLandmarks) == 432, "body_cache.cpp: write and read the new BodyLandmarks field");
 static_assert(sizeof(CharacterBody) == 528, "body_cache.cpp: write and read the new CharacterBody field");
-constexpr std::string_view magic = "drape fitted body 2\n";
+constexpr std::string_view magic = "drape fitted body 3\n";
 constexpr std::size_t encoded_ellipsoid_bytes = 4 + 12 + 16 + 12 + 1 + 4;  // as body_fields() lists one
 
 std::string number(double v) {
@@ -252,7 +252,7 @@ std::optional<BodyCacheKey> body_cache_key(const fs::path& character_file, const
         << number(options.tolerance_m) << ' ' << number(options.bulge_limit_m) << ' ' << number(options.target_coverage) << ' '
         << number(options.sample_spacing) << ' ' << number(options.min_radius_m) << ' ' << options.max_ellipsoids << ' '
         << options.tight_extra_ellipsoids << ' ' << number(options.leg_reach_m) << ' ' << number(options.arm_reach_m) << ' ' << int(options.legs) << ' '
-        << number(options.knee_radius_share) << '\n';
+        << number(options.knee_radius_share) << ' ' << number(options.thicken_thin_trunk_m) << '\n';
     const std::size_t threads = std::min(static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
                                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     key << "threads " << threads << '\n';

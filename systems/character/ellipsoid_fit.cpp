@@ -268,6 +268,7 @@ Result<void> validate(const FitOptions& o) {
     if (!(o.target_coverage > 0 && o.target_coverage <= 1)) return fail("fit.target_coverage: must be in (0, 1]");
     if (!(o.knee_radius_share >= 0 && o.knee_radius_share <= 4)) return fail("fit.knee_radius_share: must be in [0, 4] (0: no knee spheres)");
     if (o.tight_extra_ellipsoids < 0) return fail("fit.tight_extra_ellipsoids: must be >= 0");
+    if (!(o.thicken_thin_trunk_m >= 0 && o.thicken_thin_trunk_m <= 0.1)) return fail("fit.thicken_thin_trunk_m: must be in [0, 0.1] m (0: none)");
     if (o.legs != LegFit::automatic && o.legs != LegFit::tight && o.legs != LegFit::bounding)
         return fail("fit.legs: must be automatic, tight or bounding");
     return {};
@@ -575,6 +576,51 @@ bool meets_fit_targets(const CoverageReport& report, const FitOptions& options) 
     return covers_skin(report, options) && report.p95_bulge_m <= options.bulge_limit_m;
 }
 
+void thicken_thin_trunk_pieces(std::vector<EllipsoidShape>& shapes, std::span<const Affine3> global, const Matrix3X& positions,
+                               const Matrix3X& normals, const FitOptions& options) {
+    const Real thin = static_cast<Real>(options.thicken_thin_trunk_m);
+    if (!(thin > 0)) return;
+    const Real tolerance = static_cast<Real>(options.tolerance_m);
+    constexpr Real reach_m = Real(0.12), step_m = Real(0.002);  // how far behind a shell the thick pieces are looked for
+    const auto trunk = [](const EllipsoidShape& e) { return e.region == BodyRegion::torso || e.region == BodyRegion::pelvis; };
+    const auto posed = [&](const EllipsoidShape& e) { return e.bone >= 0 && static_cast<std::size_t>(e.bone) < global.size(); };
+    // Unit-sphere maps of the thick trunk pieces, as they are before any is changed.
+    std::vector<Affine3> thick;
+    for (const EllipsoidShape& e : shapes)
+        if (trunk(e) && posed(e) && e.radii_m.minCoeff() > thin)
+            thick.push_back(ellipsoid_transform(e, global[static_cast<std::size_t>(e.bone)]).inverse());
+    for (EllipsoidShape& s : shapes) {
+        if (!trunk(s) || !posed(s)) continue;
+        int axis = 0;
+        const Real r0 = s.radii_m.minCoeff(&axis);
+        if (r0 > thin) continue;
+        const Affine3 bone = rigid_part(global[static_cast<std::size_t>(s.bone)]);
+        const Affine3 placed = ellipsoid_transform(s, global[static_cast<std::size_t>(s.bone)]);
+        const Vec3 c = placed.translation();
+        const Vec3 a = (bone.linear() * s.rotation.toRotationMatrix()).col(axis);  // the thin axis, model space
+        // The skin it covers faces outward: the sum of its normals, within the tolerance.
+        Vec3 facing = Vec3::Zero();
+        const Real near = s.radii_m.maxCoeff() + tolerance;
+        for (Eigen::Index v = 0; v < positions.cols(); ++v)
+            if ((positions.col(v) - c).squaredNorm() <= near * near && outside_distance(placed, positions.col(v)) <= tolerance)
+                facing += normals.col(v).normalized();
+        const Real along = facing.dot(a);
+        if (!(std::abs(along) > 0)) continue;
+        const Vec3 inward = along > 0 ? Vec3(-a) : a;
+        Real depth = -1;  // from the centre, inward, to the first thick piece
+        for (Real t = step_m; t <= reach_m && depth < 0; t += step_m)
+            for (const Affine3& to_unit : thick)
+                if ((to_unit * (c + t * inward)).squaredNorm() < 1) {
+                    depth = t;
+                    break;
+                }
+        const Real k = (depth + tolerance - r0) / 2;
+        if (depth < 0 || k <= 0) continue;
+        s.radii_m[axis] = r0 + k;
+        s.center += bone.linear().transpose() * (k * inward);  // bone space
+    }
+}
+
 std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const MeshAsset& mesh, Real height_m,
                                            const FitOptions& options,
                                            std::span<const std::shared_ptr<const AnimationClip>> clips,
@@ -606,6 +652,7 @@ std::vector<EllipsoidShape> fit_ellipsoids(const SkeletonAsset& skeleton, const 
         for (std::size_t i = 0; i < shapes.size(); ++i)
             if (shapes[i].region == BodyRegion::lower_arm || shapes[i].region == BodyRegion::hand)
                 shapes[i].give_m = static_cast<Real>(report.bulge_per_ellipsoid_m[i]);
+    thicken_thin_trunk_pieces(shapes, global, positions, normals, options);
     return shapes;
 }
 

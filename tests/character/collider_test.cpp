@@ -168,6 +168,67 @@ TEST(EllipsoidFitting, HipBoneIsFoundByNameOrByTheLegs) {
     EXPECT_EQ(region_from_bone_name("UpperLeg.R"), BodyRegion::upper_leg);
 }
 
+// A shell 2 cm thin lies 3 cm out from a thick torso piece (a sphere of 10 cm about the
+// bone), its skin facing out (+x): thickened inward, its outer face's middle stays at
+// 14 cm and its inner face goes the tolerance (1 cm) into the sphere; the same shell with
+// its skin facing the other way is thickened the other way, and one with no thick piece
+// within reach behind it, or a thicker piece, or a piece off the trunk, is left as it was.
+TEST(EllipsoidFitting, ThinTrunkPiecesAreThickenedInwardToTheThickOnes) {
+    const std::vector<Affine3> global = {Affine3(Eigen::Translation<Real, 3>(Vec3(0, 1, 0)))};
+    EllipsoidShape sphere;
+    sphere.bone = 0;
+    sphere.radii_m = Vec3::Constant(0.10f);
+    sphere.region = BodyRegion::torso;
+    EllipsoidShape shell = sphere;
+    shell.center = Vec3(0.13f, 0, 0);
+    shell.radii_m = Vec3(0.01f, 0.05f, 0.10f);
+    // Skin on the shell's outer face, facing `out`.
+    const auto skin = [&](const Vec3& out, Matrix3X& positions, Matrix3X& normals) {
+        positions.resize(3, 9);
+        normals.resize(3, 9);
+        for (int i = 0; i < 9; ++i) {
+            positions.col(i) = Vec3(0, 1, 0) + shell.center + Real(0.01) * out + Vec3(0, Real(0.01) * (i % 3 - 1), Real(0.02) * (i / 3 - 1));
+            normals.col(i) = out;
+        }
+    };
+    FitOptions options;
+    options.thicken_thin_trunk_m = 0.015;
+    Matrix3X p, n;
+    skin(Vec3::UnitX(), p, n);
+    std::vector<EllipsoidShape> shapes = {sphere, shell};
+    thicken_thin_trunk_pieces(shapes, global, p, n, options);
+    const EllipsoidShape& thick = shapes[1];
+    EXPECT_NEAR(thick.center.x() + thick.radii_m.x(), 0.14f, 1e-5f);   // the outer face's middle
+    EXPECT_NEAR(thick.center.x() - thick.radii_m.x(), 0.09f, 0.0025f);  // 1 cm into the sphere (2 mm steps)
+    EXPECT_EQ(thick.radii_m.y(), 0.05f);
+    EXPECT_EQ(thick.radii_m.z(), 0.10f);
+    EXPECT_EQ(shapes[0].radii_m, sphere.radii_m);
+
+    // Facing the other way (the sphere is then in front of the skin, not behind it).
+    skin(-Vec3::UnitX(), p, n);
+    shapes = {sphere, shell};
+    thicken_thin_trunk_pieces(shapes, global, p, n, options);
+    EXPECT_NEAR(shapes[1].center.x() - shapes[1].radii_m.x(), 0.12f, 1e-5f);  // its inner (-x) face stays
+    EXPECT_EQ(shapes[1].radii_m.x(), 0.01f) << "nothing thick within reach behind it (+x)";
+
+    // Far from the thick piece, thicker than the option, off the trunk, or the option off.
+    skin(Vec3::UnitX(), p, n);
+    for (const auto& change : std::vector<std::function<void(EllipsoidShape&, FitOptions&)>>{
+             [](EllipsoidShape& e, FitOptions&) { e.center.x() += 0.2f; },
+             [](EllipsoidShape& e, FitOptions&) { e.radii_m.x() = 0.02f; },
+             [](EllipsoidShape& e, FitOptions&) { e.region = BodyRegion::upper_arm; },
+             [](EllipsoidShape&, FitOptions& o) { o.thicken_thin_trunk_m = 0; }}) {
+        EllipsoidShape e = shell;
+        FitOptions o = options;
+        change(e, o);
+        if (e.center.x() > 0.2f) skin(Vec3::UnitX(), p, n), p.row(0).array() += 0.2f;
+        shapes = {sphere, e};
+        thicken_thin_trunk_pieces(shapes, global, p, n, o);
+        EXPECT_EQ(shapes[1].radii_m, e.radii_m);
+        EXPECT_EQ(shapes[1].center, e.center);
+    }
+}
+
 TEST(EllipsoidFitting, OverridesFromJsonReplaceTheFittedShapeOfTheirBone) {
     const auto c = column();
     ASSERT_TRUE(c);

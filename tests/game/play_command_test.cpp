@@ -155,6 +155,7 @@ TEST_F(PlayCommand, BenchGarmentParametersAreCheckedByName) {
         {"bench quality --garment-param inertia_linear=0.5", "drape bench: --garment-param: only the motions benchmark takes it\n"},
         {"bench motions --start 0.5", "drape bench: --start: only the stability benchmark takes it\n"},
         {"bench table1 --warp-solve lines", "drape bench: --warp-solve: only the motions and stability benchmarks take it\n"},
+        {"bench quality --thicken-thin-trunk 0.015", "drape bench: --thicken-thin-trunk: only the motions benchmark takes it\n"},
     };
     for (const Case& c : cases) {
         const PlayRun run = drape(c.args, m_dir);

@@ -48,7 +48,7 @@ constexpr const char* valid_scene = R"({
   "characters": [
     {"file": "chars/body.glb", "clip": "Walk", "scale": 1.0, "position_m": [0, 0, 0],
      "rotation_deg": [0, 90, 0], "speed": 1.25, "in_place": true},
-    {"file": "chars/body.glb", "clip": 2, "position_m": [1.5, 0, -0.5], "in_place": false}
+    {"file": "chars/body.glb", "clip": 2, "position_m": [1.5, 0, -0.5], "in_place": false, "thicken_thin_trunk_m": 0.015}
   ],
   "garments": [
     {"type": "skirt", "character": 0, "model": "simplified", "collision": "lists",
@@ -75,6 +75,8 @@ TEST_F(SceneFileTest, ValidFileIsReadCompletely) {
     EXPECT_DOUBLE_EQ(scene->characters[0].speed, 1.25);
     EXPECT_FALSE(scene->characters[1].in_place);
     EXPECT_FLOAT_EQ(scene->characters[1].position_m.x(), 1.5f);
+    EXPECT_EQ(scene->characters[0].thicken_thin_trunk_m, 0.0);
+    EXPECT_DOUBLE_EQ(scene->characters[1].thicken_thin_trunk_m, 0.015);
     // Yaw 90 degrees turns +Z to +X.
     EXPECT_TRUE((scene->characters[0].rotation() * Vec3::UnitZ()).isApprox(Vec3::UnitX(), 1e-5f));
     ASSERT_EQ(scene->garments.size(), 3u);
@@ -156,6 +158,8 @@ TEST_F(SceneFileTest, WrongTypesAreNamed) {
     EXPECT_EQ(error(head + R"("scale": "big"}]})"),
               "scene.json:1:53: characters[0].scale: must be a number in (0, 1000], got string \"big\"");
     EXPECT_EQ(error(head + R"("in_place": 1}]})"), "scene.json:1:56: characters[0].in_place: must be true or false, got number 1");
+    EXPECT_EQ(error(head + R"("thicken_thin_trunk_m": 0.2}]})"),
+              "scene.json:1:68: characters[0].thicken_thin_trunk_m: must be a number in [0, 0.1], got 0.2");
     EXPECT_EQ(error(head + R"("position_m": [0, "a", 0]}]})"),
               "scene.json:1:62: characters[0].position_m[1]: must be a number in [-10000, 10000], got string \"a\"");
     EXPECT_EQ(error(R"({"characters": {"file": "chars/body.glb"}})"),
