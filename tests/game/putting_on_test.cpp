@@ -97,12 +97,13 @@ TEST(PuttingOn, ADressPutOnMidStrideStartsWithinTheContract) {
 // should start within the contract: not flung (rise above the pins, penetration, nothing
 // non-finite, no reset) and not torn. Which of them fails depends on the rounding of the
 // build (docs/characters.md). In the tests' build (DRAPE_ARCH x86-64-v2+avx+avx2+fma, AMD
-// EPYC) 11 of the 12 hold; Female_TankTop's, put on 0.2 s into her run, tears in frame 11
-// (76.5 %: a warp spring straddling a torso piece 1.0 cm thin, the class docs/cloth.md's
-// thin trunk pieces describe). With those pieces thickened inward (the body fit's
+// EPYC) 11 of the 12 hold; Female_TankTop's, put on 0.2 s into her run, is torn by the
+// settling itself (59.6 % at the first frame, 76.5 % in frame 11: a warp spring
+// straddling a torso piece 1.0 cm thin, the class docs/cloth.md's thin trunk pieces
+// describe). With those pieces thickened inward (the body fit's
 // thicken_thin_trunk_m 0.015, not the default) hers holds and Male_LongSleeve's three runs
 // tear (80-156 %). Rendered, no dress is over the chest or the face. Disabled
-// until every run holds (the issue "Any character, any motion"); run it with
+// until every run holds (the motion suite, docs/reports/motions.md); run it with
 // --gtest_also_run_disabled_tests.
 TEST(PuttingOn, DISABLED_ADressPutOnARunningCharacterStartsWithinTheContract) {
     const std::pair<const char*, const char*> runs[] = {{"characters/female_tanktop/Female_TankTop.fbx", "Female_Run"},
