@@ -2,6 +2,7 @@
 // and writes its report (docs/reports/NAME.md and a PNG plot) and, on request, its JSON.
 // `drape bench all` refreshes every report; with --json it takes a folder and writes
 // NAME.json there for each benchmark.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -158,23 +159,21 @@ void add_bench_command(CLI::App& app) {
             }
             garment_parameters.push_back(*parameter);
         }
-        if (!garment_parameters.empty() && cli->name != "motions") {
-            std::fprintf(stderr, "drape bench: --garment-param: only the motions benchmark takes it\n");
-            command_exit_code() = exit_bad_input;
-            return;
-        }
-        if (cli->start_s > 0 && cli->name != "stability") {
-            std::fprintf(stderr, "drape bench: --start: only the stability benchmark takes it\n");
-            command_exit_code() = exit_bad_input;
-            return;
-        }
-        if (!cli->warp_solve.empty() && cli->name != "motions" && cli->name != "stability") {
-            std::fprintf(stderr, "drape bench: --warp-solve: only the motions and stability benchmarks take it\n");
-            command_exit_code() = exit_bad_input;
-            return;
-        }
-        if (cli->thicken_thin_trunk_m > 0 && cli->name != "motions") {
-            std::fprintf(stderr, "drape bench: --thicken-thin-trunk: only the motions benchmark takes it\n");
+        // Options only some benchmarks take: {given, option, the benchmarks taking it}.
+        const struct {
+            bool given;
+            const char* option;
+            std::vector<std::string> takers;
+        } limited[] = {{!garment_parameters.empty(), "--garment-param", {"motions"}},
+                       {cli->start_s > 0, "--start", {"stability"}},
+                       {!cli->warp_solve.empty(), "--warp-solve", {"motions", "stability"}},
+                       {cli->thicken_thin_trunk_m > 0, "--thicken-thin-trunk", {"motions"}}};
+        for (const auto& l : limited) {
+            if (!l.given || std::find(l.takers.begin(), l.takers.end(), cli->name) != l.takers.end()) continue;
+            std::string which = "the " + l.takers[0];
+            for (std::size_t i = 1; i < l.takers.size(); ++i) which += (i + 1 == l.takers.size() ? " and " : ", ") + l.takers[i];
+            std::fprintf(stderr, "drape bench: %s: only %s benchmark%s take%s it\n", l.option, which.c_str(),
+                         l.takers.size() > 1 ? "s" : "", l.takers.size() > 1 ? "" : "s");
             command_exit_code() = exit_bad_input;
             return;
         }
