@@ -9,6 +9,7 @@
 
 #include "drape/components/garment_surface.hpp"
 #include "drape/components/body_landmarks.hpp"
+#include "drape/components/character.hpp"
 #include "drape/components/skeleton.hpp"
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/skinning.hpp"
@@ -478,8 +479,20 @@ Result<std::string> place_on_current_pose(const Registry& registry, Entity chara
     return how.str();
 }
 
+Result<void> check_garment_units(const GarmentMeshAsset& mesh, Real height_m, std::string_view name) {
+    if (!(height_m > 0) || mesh.positions.cols() == 0) return {};
+    const Real span = (mesh.positions.rowwise().maxCoeff() - mesh.positions.rowwise().minCoeff()).norm();
+    if (span <= garment_units_factor * height_m && span * garment_units_factor >= height_m) return {};
+    std::ostringstream what;
+    what << name << ": mesh '" << mesh.name << "' spans " << number(span) << " m against a character " << number(height_m)
+         << " m tall (" << number(span / height_m) << " times): not in the character's units (model it in them, or scale it)";
+    return fail(what.str());
+}
+
 Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const GarmentMeshAsset& authored, const MeshGarmentParams& params,
                                    std::string_view name) {
+    if (const auto* c = registry.try_get<Character>(character))
+        if (auto units = check_garment_units(authored, c->height_m, name); !units) return std::unexpected(units.error());
     GarmentMeshAsset mesh = authored;
     if (auto placed = place_on_current_pose(registry, character, params.modelled_on, mesh, name); !placed)
         return std::unexpected(placed.error());

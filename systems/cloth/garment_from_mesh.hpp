@@ -84,8 +84,18 @@ struct MeshGrid {
 [[nodiscard]] Result<std::string> place_on_current_pose(const Registry& registry, Entity character, GarmentPose pose,
                                                         GarmentMeshAsset& mesh, std::string_view name);
 
+/// A garment mesh spanning more than this many times its character's height, or less than
+/// its height over this, is taken to be in other units (centimetres against metres: 100x).
+inline constexpr Real garment_units_factor = 10;
+
+/// Fails, prefixed with `name` and naming the mesh, when `mesh` (the diagonal of its box)
+/// spans more than garment_units_factor times `height_m` or less than `height_m` over it;
+/// no check where `height_m` is not positive.
+[[nodiscard]] Result<void> check_garment_units(const GarmentMeshAsset& mesh, Real height_m, std::string_view name);
+
 /// `mesh` (in `character`'s model space, modelled on the pose params.modelled_on says) as
-/// cloth on `character` (attach_grid_garment).
+/// cloth on `character` (attach_grid_garment); a mesh in other units than the character
+/// (check_garment_units, against Character::height_m) is refused.
 [[nodiscard]] Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const GarmentMeshAsset& mesh,
                                                  const MeshGarmentParams& params, std::string_view name);
 

@@ -513,6 +513,23 @@ TEST_F(GarmentFile, BadFilesAndFieldsGetOneLineNamingThem) {
     EXPECT_NE(message(grid_from_mesh(slit, spaced, "garments[0]")).find("fall outside it: a panel must be one piece across"),
               std::string::npos) << message(grid_from_mesh(slit, spaced, "garments[0]"));
 
+    // Another unit than the character's (centimetres against metres, and back): one line.
+    for (const Real scale : {Real(100), Real(0.01)}) {
+        GarmentMeshAsset scaled = mesh;
+        scaled.positions *= scale;
+        const fs::path scaled_file = dir / (scale > 1 ? "skirt_cm.gltf" : "skirt_hm.gltf");
+        ASSERT_TRUE(write_garment_mesh(scaled_file, scaled));
+        auto refused = build_world(put_on(from_file(scaled_file)), {});
+        ASSERT_FALSE(refused) << scale;
+        EXPECT_NE(refused.error().message.find("garments[0]: mesh 'Garment' spans "), std::string::npos) << refused.error().message;
+        EXPECT_NE(refused.error().message.find("not in the character's units"), std::string::npos) << refused.error().message;
+    }
+    EXPECT_TRUE(check_garment_units(mesh, Real(1.75), "g"));
+    GarmentMeshAsset tall = mesh;
+    tall.positions *= Real(20);
+    EXPECT_FALSE(check_garment_units(tall, Real(1.75), "g"));
+    EXPECT_TRUE(check_garment_units(tall, Real(0), "g")) << "no height: no check";
+
     // Scene fields.
     GarmentDescription shaped = from_file(file);
     shaped.parameters.push_back({"length_m", 0.4});
