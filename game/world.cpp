@@ -235,7 +235,11 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         const Result<Entity> garment = !g.file.empty()                ? attach_file_garment(world.registry, body, g, *params, field, world.warnings)
                                        : g.type == GarmentType::skirt ? attach_skirt(world.registry, body, *params)
                                                                       : attach_dress(world.registry, body, *params);
-        if (!garment) return fail(located(g.where, field, garment.error().message));
+        if (!garment) {
+            // Errors from a file's garment are already named by the field.
+            const std::string& why = garment.error().message;
+            return fail(located(g.where, why.starts_with(field + ": ") ? std::string() : field, why));
+        }
         world.registry.get<Garment>(*garment).config.warp_solve = g.warp_solve;
         world.garments.push_back(*garment);
     }

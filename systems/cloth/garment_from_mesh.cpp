@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include "drape/components/garment_surface.hpp"
 #include "drape/components/body_landmarks.hpp"
 #include "drape/components/character.hpp"
+#include "drape/components/ellipsoid_collider.hpp"
 #include "drape/components/skeleton.hpp"
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/skinning.hpp"
@@ -489,6 +491,96 @@ Result<void> check_garment_units(const GarmentMeshAsset& mesh, Real height_m, st
     return fail(what.str());
 }
 
+GarmentPlacement measure_garment_placement(Registry& registry, Entity character, const GridGarment& grid) {
+    GarmentPlacement out;
+    struct Body {
+        Affine3 to_unit;
+        Vec3 center;
+        bool trunk;
+    };
+    std::vector<Body> bodies;
+    registry.view<EllipsoidCollider>().each([&](Entity, const EllipsoidCollider& c) {
+        if (c.character != character || !c.placed) return;
+        bodies.push_back({c.world.inverse(), c.world.translation(), c.region == BodyRegion::pelvis || c.region == BodyRegion::torso});
+    });
+    const auto cells = static_cast<Eigen::Index>(grid.grid_positions.cols());
+    if (bodies.empty() || cells == 0 || grid.pinned.size() != static_cast<std::size_t>(cells)) return out;
+    const auto* transform = registry.try_get<Transform>(character);
+    const Affine3 to_world = transform ? transform->matrix() : Affine3::Identity();
+    std::size_t inside = 0;
+    std::vector<Real> held;
+    Vec3 held_center = Vec3::Zero();
+    for (Eigen::Index k = 0; k < cells; ++k) {
+        const Vec3 p = to_world * Vec3(grid.grid_positions.col(k));
+        // The radial distance from the nearest ellipsoid's surface (0 inside), and the depth
+        // in the deepest one (its unit sphere's radius through the point).
+        Real nearest = std::numeric_limits<Real>::infinity(), deepest = nearest;
+        for (const Body& b : bodies) {
+            const Real s = (b.to_unit * p).norm();
+            nearest = std::min(nearest, s <= 1 ? Real(0) : (p - b.center).norm() * (1 - 1 / s));
+            deepest = std::min(deepest, s);
+        }
+        inside += deepest < 1 - garment_inside_depth ? 1 : 0;
+        if (grid.pinned[static_cast<std::size_t>(k)]) held.push_back(nearest), held_center += p;
+    }
+    out.inside_share = Real(inside) / Real(cells);
+    if (held.empty()) return out;
+    held_center /= Real(held.size());
+    std::nth_element(held.begin(), held.begin() + static_cast<std::ptrdiff_t>(held.size() / 2), held.end());
+    out.held_distance_m = held[held.size() / 2];
+    if (!grid.closed || grid.warp_lines < 3 || grid.particles_per_line < 1) return out;
+    // Round the body: the turns its held edge (each line's highest held point, in line order)
+    // makes, seen from above, about the centre of the trunk's ellipsoid nearest the held points.
+    const Body* axis = nullptr;
+    for (const Body& b : bodies)
+        if (!axis || (b.trunk && !axis->trunk) ||
+            (b.trunk == axis->trunk && (b.center - held_center).squaredNorm() < (axis->center - held_center).squaredNorm()))
+            axis = &b;
+    std::vector<Vec3> edge;
+    const auto m = static_cast<std::size_t>(grid.particles_per_line);
+    for (std::size_t line = 0; line < static_cast<std::size_t>(grid.warp_lines); ++line)
+        for (std::size_t row = 0; row < m; ++row)
+            if (grid.pinned[line * m + row]) {
+                edge.push_back(to_world * Vec3(grid.grid_positions.col(static_cast<Eigen::Index>(line * m + row))) - axis->center);
+                break;
+            }
+    Real turned = 0;
+    for (std::size_t i = 0; i < edge.size(); ++i) {
+        const Vec3& a = edge[i];
+        const Vec3& b = edge[(i + 1) % edge.size()];
+        turned += std::atan2(a.z() * b.x() - a.x() * b.z(), a.x() * b.x() + a.z() * b.z());
+    }
+    out.turns_round_body = std::abs(turned) / (2 * std::numbers::pi_v<Real>);
+    return out;
+}
+
+Result<void> check_garment_placement(Registry& registry, Entity character, const GridGarment& grid, std::string_view mesh_name,
+                                     std::string_view name) {
+    const GarmentPlacement placed = measure_garment_placement(registry, character, grid);
+    std::ostringstream what;
+    what.precision(2);
+    what << name << ": mesh '" << mesh_name << "' ";
+    if (placed.inside_share > garment_inside_share) {
+        what << "lies inside the body (" << number(std::round(100 * placed.inside_share)) << " % of it deeper than "
+             << number(100 * garment_inside_depth) << " % into the body's ellipsoids; at most " << number(100 * garment_inside_share)
+             << " %): model it over the body";
+        return fail(what.str());
+    }
+    if (placed.turns_round_body < Real(0.5)) {
+        what << "is closed round, but its held edge does not go round the body (" << std::fixed << placed.turns_round_body
+             << " turns round the trunk): model it around the character";
+        return fail(what.str());
+    }
+    const auto* c = registry.try_get<Character>(character);
+    if (c && c->height_m > 0 && placed.held_distance_m > garment_far_fraction * c->height_m) {
+        what << "is held " << std::fixed << placed.held_distance_m << " m from the body (the median of its held points; at most "
+             << number(100 * garment_far_fraction) << " % of the character's height, " << garment_far_fraction * c->height_m
+             << " m): model it on the body";
+        return fail(what.str());
+    }
+    return {};
+}
+
 Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const GarmentMeshAsset& authored, const MeshGarmentParams& params,
                                    std::string_view name) {
     if (const auto* c = registry.try_get<Character>(character))
@@ -498,6 +590,8 @@ Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const G
         return std::unexpected(placed.error());
     auto grid = grid_from_mesh(mesh, params, name);
     if (!grid) return std::unexpected(grid.error());
+    if (auto placed = check_garment_placement(registry, character, grid->grid, authored.name, name); !placed)
+        return std::unexpected(placed.error());
     auto garment = attach_grid_garment(registry, character, grid->grid, name);
     if (!garment) return garment;
     // Drawn as authored: the mesh itself, carried by the grid's particles.

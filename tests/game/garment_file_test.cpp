@@ -524,6 +524,32 @@ TEST_F(GarmentFile, BadFilesAndFieldsGetOneLineNamingThem) {
         EXPECT_NE(refused.error().message.find("garments[0]: mesh 'Garment' spans "), std::string::npos) << refused.error().message;
         EXPECT_NE(refused.error().message.find("not in the character's units"), std::string::npos) << refused.error().message;
     }
+    // Placed wrong on the body: beside it, shrunk into it, or held far round it: one line.
+    Vec3 held = Vec3::Zero();
+    Real held_count = 0;
+    for (Eigen::Index v = 0; v < mesh.positions.cols(); ++v)
+        if (mesh.pin[v] >= Real(0.5)) held += mesh.positions.col(v), held_count += 1;
+    ASSERT_GT(held_count, 0);
+    held /= held_count;
+    const struct {
+        const char* file;
+        Vec3 scale;
+        Vec3 offset;
+        const char* reason;
+    } misplaced[] = {
+        {"beside.gltf", Vec3::Ones(), Vec3(Real(0.8), 0, 0), "is closed round, but its held edge does not go round the body (0.00 turns"},
+        {"inside.gltf", Vec3::Constant(Real(0.3)), Vec3::Zero(), "lies inside the body ("},
+        {"wide.gltf", Vec3(3, 1, 3), Vec3::Zero(), "m from the body (the median of its held points; at most 10 % of the character's height"},
+    };
+    for (const auto& wrong : misplaced) {
+        GarmentMeshAsset moved = mesh;
+        moved.positions = ((moved.positions.colwise() - held).array().colwise() * wrong.scale.array()).matrix().colwise() + (held + wrong.offset);
+        ASSERT_TRUE(write_garment_mesh(dir / wrong.file, moved));
+        auto refused = build_world(put_on(from_file(dir / wrong.file)), {});
+        ASSERT_FALSE(refused) << wrong.file;
+        EXPECT_TRUE(refused.error().message.starts_with("garments[0]: mesh 'Garment' ")) << refused.error().message;
+        EXPECT_NE(refused.error().message.find(wrong.reason), std::string::npos) << refused.error().message;
+    }
     EXPECT_TRUE(check_garment_units(mesh, Real(1.75), "g"));
     GarmentMeshAsset tall = mesh;
     tall.positions *= Real(20);
