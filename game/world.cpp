@@ -51,8 +51,11 @@ constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
 // as MeshGarmentParams says, the cloth from `params` (the scene's material, model, colour,
 // weft_stride and fitting_rows); the built-in garments' shape parameters do not apply. A
 // file that paints no pins, held at its higher edge instead, adds a line to `warnings`.
+// The character's own file (`character`, read as `asset`, fitted as `fit`): a mesh modelled
+// into it, in its bind pose (garment_mesh_of_character), whose meshes go to `own`.
 Result<Entity> attach_file_garment(Registry& registry, Entity body, const GarmentDescription& g, const TubeParams& params,
-                                   const std::string& field, std::vector<std::string>& warnings) {
+                                   const std::string& field, std::vector<std::string>& warnings, const fs::path& character,
+                                   const CharacterAsset& asset, const CharacterBody& fit, std::vector<std::size_t>& own) {
     for (const GarmentParameter& p : g.parameters) {
         const GarmentParameterSpec* spec = find_garment_parameter(p.name);
         if (p.name != "weft_stride" && p.name != "fitting_rows" && !p.name.starts_with("inertia_") && !(spec && spec->in_material()))
@@ -71,6 +74,16 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
     mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular, params.inertia_max_linear_m_s2, params.inertia_max_fall_m_s2};
     mp.config.color = params.color;
     mp.pin_weights = params.pin_weights;
+    std::error_code ec;
+    if (fs::equivalent(g.file, character, ec)) {
+        std::vector<std::size_t> modelled;
+        for (const LeftOutMesh& part : fit.left_out)
+            if (part.garment) modelled.push_back(part.mesh);
+        auto mesh = garment_mesh_of_character(asset, g.mesh, modelled, field, &own);
+        if (!mesh) return std::unexpected(mesh.error());
+        mp.modelled_on = GarmentPose::bind;
+        return attach_mesh_garment(registry, body, *mesh, mp, field);
+    }
     auto mesh = import_garment_mesh(g.file, g.mesh);
     if (!mesh) return std::unexpected(mesh.error());
     if (g.pins == PinSource::file && mesh->pin.size() == 0)
@@ -232,7 +245,11 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         const Entity body = world.characters.at(static_cast<std::size_t>(g.character));
         auto params = tube_params(g);
         if (!params) return fail(located(g.where, field, params.error().message));
-        const Result<Entity> garment = !g.file.empty()                ? attach_file_garment(world.registry, body, g, *params, field, world.warnings)
+        const CharacterDescription& worn_by = scene.characters.at(static_cast<std::size_t>(g.character));
+        const Loaded& character = loaded.at({worn_by.file, worn_by.thicken_thin_trunk_m});
+        std::vector<std::size_t> own;
+        const Result<Entity> garment = !g.file.empty() ? attach_file_garment(world.registry, body, g, *params, field, world.warnings,
+                                                                             worn_by.file, *character.asset, character.body, own)
                                        : g.type == GarmentType::skirt ? attach_skirt(world.registry, body, *params)
                                                                       : attach_dress(world.registry, body, *params);
         if (!garment) {
@@ -242,6 +259,13 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         }
         world.registry.get<Garment>(*garment).config.warp_solve = g.warp_solve;
         world.garments.push_back(*garment);
+        // A mesh of the character's own file that is now cloth is not drawn skinned too.
+        if (auto* skin = world.registry.try_get<SkinnedMesh>(body); skin && skin->mesh)
+            for (const std::size_t k : own)
+                if (k < skin->mesh->submeshes.size()) {
+                    skin->hidden.resize(skin->mesh->submeshes.size(), 0);
+                    skin->hidden[k] = 1;
+                }
     }
     // A garment simulated over one modelled into the file: the modelled one is not drawn.
     for (std::size_t i = 0; i < scene.characters.size(); ++i) {

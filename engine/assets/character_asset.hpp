@@ -35,6 +35,7 @@ struct MeshInfo {
     std::uint32_t vertex_count = 0;
     bool rigid = false;   ///< Had no skin: bound with weight 1 to the bone it hangs from.
     std::string material; ///< Its material's name ("" when it has none).
+    bool has_uvs = false; ///< Has a UV set (MeshAsset::uvs).
 };
 
 struct CharacterAsset {

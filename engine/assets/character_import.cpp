@@ -313,6 +313,7 @@ Result<void> build_mesh(Builder& b, MeshAsset& out, std::vector<MeshInfo>& infos
     out.bind_normals.resize(3, n);
     out.bone_indices.setZero(4, n);
     out.bone_weights.setZero(4, n);
+    out.uvs.setZero(2, n);
     Eigen::Index base = 0;
     for (const Placed& p : placed) {
         const aiMesh* mesh = p.mesh;
@@ -395,6 +396,7 @@ Result<void> build_mesh(Builder& b, MeshAsset& out, std::vector<MeshInfo>& infos
                 out.bind_normals.col(j) = (to_bind.linear() * normal).normalized();
             }
             if (!out.bind_normals.col(j).allFinite()) out.bind_normals.col(j) = Vec3::UnitY();
+            if (mesh->HasTextureCoords(0)) out.uvs.col(j) = Eigen::Vector2f(mesh->mTextureCoords[0][v].x, mesh->mTextureCoords[0][v].y);
         }
         Submesh sub;
         sub.name = mesh_name;
@@ -413,7 +415,8 @@ Result<void> build_mesh(Builder& b, MeshAsset& out, std::vector<MeshInfo>& infos
         out.submeshes.push_back(sub);
         aiString material;
         if (mesh->mMaterialIndex < scene->mNumMaterials) scene->mMaterials[mesh->mMaterialIndex]->Get(AI_MATKEY_NAME, material);
-        infos.push_back({mesh_name, static_cast<std::uint32_t>(base), nv, mesh->mNumBones == 0 || any_rigid, material.C_Str()});
+        infos.push_back({mesh_name, static_cast<std::uint32_t>(base), nv, mesh->mNumBones == 0 || any_rigid, material.C_Str(),
+                         mesh->HasTextureCoords(0)});
         base += nv;
     }
     return {};

@@ -25,6 +25,7 @@ struct MeshAsset {
     Matrix3X bind_normals;
     Eigen::Matrix<std::int32_t, 4, Eigen::Dynamic> bone_indices;  ///< Up to 4 influences (unused: index 0, weight 0).
     Matrix4X bone_weights;                    ///< Each column sums to 1.
+    Matrix2X uvs;                             ///< First UV set per vertex (0, 0 in a mesh without one: MeshInfo::has_uvs).
     std::vector<std::uint32_t> indices;       ///< Triangles, counter-clockwise.
     std::vector<Submesh> submeshes;
 

@@ -606,6 +606,56 @@ Result<Entity> attach_garment_file(Registry& registry, Entity character, const s
     return attach_mesh_garment(registry, character, *mesh, params, name);
 }
 
+Result<GarmentMeshAsset> garment_mesh_of_character(const CharacterAsset& asset, std::string_view mesh_name,
+                                                   std::span<const std::size_t> modelled, std::string_view name,
+                                                   std::vector<std::size_t>* used) {
+    const std::string file = asset.source.string();
+    std::string names;
+    for (const MeshInfo& info : asset.meshes)
+        if (names.find("'" + info.name + "'") == std::string::npos) names.append(names.empty() ? "" : ", ").append("'" + info.name + "'");
+    std::vector<std::size_t> chosen;
+    std::string label(mesh_name);
+    if (mesh_name.empty()) {
+        if (modelled.size() != 1) {
+            std::string found;
+            for (const std::size_t k : modelled) found.append(found.empty() ? "" : ", ").append("'" + asset.meshes.at(k).name + "'");
+            return fail(std::string(name) + ": " + file + " holds " + (modelled.empty() ? "no modelled garment" : found) +
+                        ": name the mesh to simulate as " + file + ":MESH (meshes: " + names + ")");
+        }
+        label = asset.meshes.at(modelled.front()).name;
+    }
+    for (std::size_t k = 0; k < asset.meshes.size(); ++k)
+        if (asset.meshes[k].name == label) chosen.push_back(k);
+    if (chosen.empty()) return fail(std::string(name) + ": " + file + ": no mesh named '" + label + "' (meshes: " + names + ")");
+    const MeshAsset& mesh = *asset.mesh;
+    GarmentMeshAsset out;
+    out.name = label;
+    std::size_t total = 0;
+    for (const std::size_t k : chosen) {
+        if (!asset.meshes[k].has_uvs || mesh.uvs.cols() != mesh.bind_positions.cols())
+            return fail(std::string(name) + ": mesh '" + label + "' of " + file + " has no UV coordinates (a pattern is needed to grid it)");
+        total += asset.meshes[k].vertex_count;
+    }
+    out.positions.resize(3, static_cast<Eigen::Index>(total));
+    out.uvs.resize(2, static_cast<Eigen::Index>(total));
+    Eigen::Index at = 0;
+    for (const std::size_t k : chosen) {
+        const MeshInfo& info = asset.meshes[k];
+        const Eigen::Index first = info.first_vertex, count = info.vertex_count;
+        out.positions.middleCols(at, count) = mesh.bind_positions.middleCols(first, count);
+        out.uvs.middleCols(at, count) = mesh.uvs.middleCols(first, count);
+        if (k < mesh.submeshes.size()) {
+            const Submesh& sub = mesh.submeshes[k];
+            for (std::uint32_t i = sub.first_index; i < sub.first_index + sub.index_count; ++i)
+                out.indices.push_back(static_cast<std::uint32_t>(mesh.indices[i] - static_cast<std::uint32_t>(first) + static_cast<std::uint32_t>(at)));
+        }
+        at += count;
+    }
+    if (out.indices.empty()) return fail(std::string(name) + ": mesh '" + label + "' of " + file + " has no triangles");
+    if (used) *used = chosen;
+    return out;
+}
+
 GarmentMeshAsset garment_as_mesh(Registry& registry, Entity garment) {
     const Garment& g = registry.get<Garment>(garment);
     const Fabric& f = *g.fabric;

@@ -32,10 +32,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 
 #include "drape/components/garment.hpp"
+#include "drape/engine/assets/character_asset.hpp"
 #include "drape/engine/assets/garment_file.hpp"
 #include "drape/engine/core/error.hpp"
 #include "drape/engine/core/registry.hpp"
@@ -131,6 +133,17 @@ inline constexpr Real garment_far_fraction = Real(0.1);
 [[nodiscard]] Result<Entity> attach_garment_file(Registry& registry, Entity character, const std::filesystem::path& file,
                                                  std::string_view mesh_name = {}, const MeshGarmentParams& params = {},
                                                  std::string_view name = "garment");
+
+/// A mesh modelled into a character's own file (a skirt, a dress) as a garment mesh, in its
+/// bind pose in the character's model space (units and axes as the character was read; to be
+/// placed with GarmentPose::bind): every mesh of `asset` named `mesh_name` (a mesh an
+/// exporter split per material is read whole), or, with no name, the one mesh of
+/// `modelled` (indices into CharacterAsset::meshes: the modelled garments the body fit left
+/// out). No pins are painted; no texture is read. `used` receives the meshes taken. Errors
+/// are prefixed with `name` and list the meshes to choose from.
+[[nodiscard]] Result<GarmentMeshAsset> garment_mesh_of_character(const CharacterAsset& asset, std::string_view mesh_name,
+                                                                 std::span<const std::size_t> modelled, std::string_view name,
+                                                                 std::vector<std::size_t>* used = nullptr);
 
 /// `garment`'s cut as a mesh in its character's model space: its particle grid as it was
 /// built (Fabric::rest_shape, the shape its rest lengths were measured on, before it was

@@ -6,6 +6,7 @@
 // hint only, and the fit and the landmarks leave out what is not the body.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -16,6 +17,8 @@
 #include <assimp/scene.h>
 
 #include "drape/components/body_landmarks.hpp"
+#include "drape/components/garment.hpp"
+#include "drape/components/transform.hpp"
 #include "drape/components/skinned_mesh.hpp"
 #include "drape/engine/assets/character_import.hpp"
 #include "drape/game/avatar_generator.hpp"
@@ -63,30 +66,34 @@ aiMesh* box(const char* name, const Vec3& lo, const Vec3& hi) {
 }
 
 // A cone of cloth round the hips, hanging to the knees (a skirt modelled into the file),
-// skinned to `bone` with weight 1.
+// skinned to `bone` with weight 1, its pattern unwrapped as a tailor's would be: u round
+// the body (the seam's vertices twice, at u = 0 and 1), v down it.
 aiMesh* modelled_skirt(const char* name, const char* bone, const Vec3& joint, Real top_y, Real bottom_y, Real top_r, Real bottom_r) {
     auto* mesh = new aiMesh();
     mesh->mName = aiString(name);
     mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
-    constexpr unsigned around = 24, down = 16;
-    mesh->mNumVertices = around * down;
-    mesh->mVertices = new aiVector3D[around * down];
-    mesh->mNormals = new aiVector3D[around * down];
+    constexpr unsigned around = 24, down = 16, columns = around + 1;
+    mesh->mNumVertices = columns * down;
+    mesh->mVertices = new aiVector3D[columns * down];
+    mesh->mNormals = new aiVector3D[columns * down];
+    mesh->mTextureCoords[0] = new aiVector3D[columns * down];
+    mesh->mNumUVComponents[0] = 2;
     for (unsigned r = 0; r < down; ++r)
-        for (unsigned a = 0; a < around; ++a) {
-            const Real u = Real(r) / (down - 1), angle = Real(2 * M_PI * a / around);
+        for (unsigned a = 0; a < columns; ++a) {
+            const Real u = Real(r) / (down - 1), angle = Real(2 * M_PI * (a % around) / around);
             const Real radius = top_r + u * (bottom_r - top_r), y = top_y + u * (bottom_y - top_y);
-            mesh->mVertices[r * around + a] = aiVector3D(radius * std::cos(angle), y, radius * std::sin(angle));
-            mesh->mNormals[r * around + a] = aiVector3D(std::cos(angle), 0, std::sin(angle));
+            mesh->mVertices[r * columns + a] = aiVector3D(radius * std::cos(angle), y, radius * std::sin(angle));
+            mesh->mNormals[r * columns + a] = aiVector3D(std::cos(angle), 0, std::sin(angle));
+            mesh->mTextureCoords[0][r * columns + a] = aiVector3D(Real(a) / around, 1 - u, 0);
         }
     mesh->mNumFaces = 2 * around * (down - 1);
     mesh->mFaces = new aiFace[mesh->mNumFaces];
     unsigned f = 0;
     for (unsigned r = 0; r + 1 < down; ++r)
         for (unsigned a = 0; a < around; ++a) {
-            const unsigned b = (a + 1) % around;
-            for (const auto& t : {std::array<unsigned, 3>{r * around + a, (r + 1) * around + a, r * around + b},
-                                  std::array<unsigned, 3>{r * around + b, (r + 1) * around + a, (r + 1) * around + b}}) {
+            const unsigned b = a + 1;
+            for (const auto& t : {std::array<unsigned, 3>{r * columns + a, (r + 1) * columns + a, r * columns + b},
+                                  std::array<unsigned, 3>{r * columns + b, (r + 1) * columns + a, (r + 1) * columns + b}}) {
                 mesh->mFaces[f].mNumIndices = 3;
                 mesh->mFaces[f].mIndices = new unsigned[3]{t[0], t[1], t[2]};
                 ++f;
@@ -302,6 +309,75 @@ TEST(CharacterVariants, AModelledSkirtIsLeftOutAndHiddenUnderASimulatedOne) {
             EXPECT_EQ(hidden, hide);
         }
     }
+}
+
+// A skirt modelled into the character's file becomes the cloth: the scene's garment names
+// the character's own file (and the mesh, or the one modelled garment); the mesh is read as
+// the character was (units, axes), placed from its bind pose, and no longer drawn skinned.
+TEST(CharacterVariants, AModelledSkirtOfTheCharactersOwnFileBecomesTheCloth) {
+    const fs::path file = temp_file("own_skirt");
+    write_with_modelled_skirt(file, "Skirt");
+    const int hips = avatar().find_bone("Hips");
+    ASSERT_GE(hips, 0);
+    const Real joint_y = avatar().bones[std::size_t(hips)].joint_m.cast<Real>().y();
+    const Real top_y = joint_y + Real(0.08), bottom_y = joint_y - Real(0.45), top_r = Real(0.17), bottom_r = Real(0.3);
+    for (const char* mesh : {"", "Skirt"}) {
+        SCOPED_TRACE(mesh);
+        SceneDescription scene = sample_scene();
+        scene.characters.at(0).file = file;
+        scene.characters.at(0).hide_modelled_garments = false;  // hidden all the same: it is the cloth now
+        GarmentDescription g;
+        g.file = file;
+        g.mesh = mesh;
+        scene.garments = {g};
+        scene.solver.settle_s = 0;
+        auto world = build_world(scene, {});
+        ASSERT_TRUE(world) << world.error().message;
+        const Entity character = world->characters.at(0);
+        const auto& skin = world->registry.get<SkinnedMesh>(character);
+        std::size_t skirt_mesh = skin.mesh->submeshes.size();
+        for (std::size_t k = 0; k < skin.mesh->submeshes.size(); ++k)
+            if (skin.mesh->submeshes[k].name == "Skirt") skirt_mesh = k;
+        ASSERT_LT(skirt_mesh, skin.mesh->submeshes.size());
+        EXPECT_TRUE(skirt_mesh < skin.hidden.size() && skin.hidden[skirt_mesh]) << "the modelled skirt is not drawn skinned under its cloth";
+        // The cloth where the skirt was modelled (the sample scene's first pose stands as the
+        // bind pose's trunk does): its particles on the cone, in the character's model space.
+        const Garment& cloth = world->registry.get<Garment>(world->garments.at(0));
+        const auto* placed = world->registry.try_get<Transform>(character);
+        const Affine3 to_model = placed ? Affine3(placed->matrix().inverse()) : Affine3::Identity();
+        std::vector<Real> off;
+        for (Eigen::Index p = 0; p < cloth.state.x.cols(); ++p) {
+            const Vec3 q = to_model * Vec3(cloth.state.x.col(p));
+            const Real along = std::clamp((top_y - q.y()) / (top_y - bottom_y), Real(0), Real(1));
+            off.push_back(std::abs(std::hypot(q.x(), q.z()) - (top_r + along * (bottom_r - top_r))));
+            EXPECT_GT(q.y(), bottom_y - Real(0.03));
+            EXPECT_LT(q.y(), top_y + Real(0.03));
+        }
+        std::nth_element(off.begin(), off.begin() + static_cast<std::ptrdiff_t>(off.size() / 2), off.end());
+        EXPECT_LT(off[off.size() / 2], Real(0.015)) << "median distance of the cloth from the modelled cone";
+        for (int frame = 0; frame < 30; ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+        EXPECT_TRUE(world->registry.get<Garment>(world->garments.at(0)).state.x.allFinite());
+    }
+    // A mesh the file does not hold, and a file with no modelled garment: one line naming them.
+    SceneDescription scene = sample_scene();
+    scene.characters.at(0).file = file;
+    GarmentDescription g;
+    g.file = file;
+    g.mesh = "Belt";
+    scene.garments = {g};
+    auto belt = build_world(scene, {});
+    ASSERT_FALSE(belt);
+    EXPECT_NE(belt.error().message.find("garments[0]: " + file.string() + ": no mesh named 'Belt' (meshes: "), std::string::npos)
+        << belt.error().message;
+    const fs::path plain = temp_file("no_modelled_garment");
+    write(*to_assimp_scene(avatar()), plain);
+    scene.characters.at(0).file = plain;
+    scene.garments.at(0).file = plain;
+    scene.garments.at(0).mesh.clear();
+    auto none = build_world(scene, {});
+    ASSERT_FALSE(none);
+    EXPECT_NE(none.error().message.find("holds no modelled garment: name the mesh to simulate as"), std::string::npos)
+        << none.error().message;
 }
 
 }  // namespace
