@@ -115,6 +115,7 @@ struct GarmentSolver {
     Matrix3X pin_previous, pin_target;       ///< Pin positions at the start and end of the fixed step.
     std::vector<EllipsoidFrame> pin_frames;  ///< Scratch: the colliders at the end of the fixed step, for the pins.
     Vec3 anchor_velocity_before = Vec3::Zero();      ///< The anchor's V when the velocities were last written.
+    Vec3 anchor_velocity_earlier = Vec3::Zero();     ///< Its V one fixed step before that (the fall bound's two-step acceleration).
     Vec3 anchor_angular_before = Vec3::Zero();       ///< Its W then.
     bool anchor_known = false;               ///< False: no step yet (the anchor's motion so far counts as none).
     double settled_s = 0;                    ///< Simulated time since the build or the last reset.

@@ -74,7 +74,9 @@ AnchorMotion anchor_motion(const Registry& registry, const Garment& g, GarmentSo
     m.velocity_m_s = f1.velocity_m_s;
     m.angular_velocity_rad_s = f1.angular_velocity_rad_s;
     m.acceleration_m_s2 = f1.acceleration_m_s2;
+    m.step_s = static_cast<Real>(sub.h_s) * Real(sub.count);
     m.velocity_before_m_s = s.anchor_known ? s.anchor_velocity_before : m.velocity_m_s;
+    m.velocity_earlier_m_s = s.anchor_known ? s.anchor_velocity_earlier : m.velocity_before_m_s;
     m.angular_velocity_before_rad_s = s.anchor_known ? s.anchor_angular_before : m.angular_velocity_rad_s;
     return m;
 }
@@ -115,6 +117,7 @@ void integrate_garment(const Registry& registry, Garment& g, GarmentSolver& s, c
         s.settling = s.settled_s < settling_s * (1 - 1e-9);  // the steps of the first settling_s, rounding aside
         s.settled_s += sub.fixed_dt_s;
     }
+    if (sub.index == 0) s.anchor_velocity_earlier = motion.velocity_before_m_s;
     s.anchor_velocity_before = motion.velocity_m_s;
     s.anchor_angular_before = motion.angular_velocity_rad_s;
     s.anchor_known = true;

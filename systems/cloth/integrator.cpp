@@ -22,7 +22,11 @@ void predict_particles(Matrix3X& x, Matrix3X& v, const VectorX& inv_mass, const 
     Vec3 down = Vec3::Zero();
     if (inertia.max_fall_m_s2 > 0 && g.squaredNorm() > 0) {
         down = g.normalized();
-        const Real falling = s_lin * f.acceleration_m_s2.dot(down);
+        // Over the last two fixed steps where they are known: a clip keyed at 30 Hz and played
+        // at 60 moves its root every other step, whose one-step acceleration is then twice
+        // the motion's (a walk's hips at 2 g on one step and 0 on the next).
+        const Vec3 a = f.step_s > 0 ? Vec3((f.velocity_m_s - f.velocity_earlier_m_s) / (2 * f.step_s)) : f.acceleration_m_s2;
+        const Real falling = s_lin * a.dot(down);
         if (falling > inertia.max_fall_m_s2) s_fall = s_lin * inertia.max_fall_m_s2 / falling;
     }
     if (s_lin == 1 && s_fall == 1 && inertia.angular == 1) {

@@ -24,7 +24,8 @@
 //   With a bound on the felt acceleration (InertiaScales::max_linear_m_s2 > 0) a step whose
 //   s_lin |a_b| exceeds it takes s_lin x bound / (s_lin |a_b|) as its linear scale. With a
 //   fall bound (InertiaScales::max_fall_m_s2 > 0) a step whose felt acceleration along
-//   gravity, s_lin a_b . d (d = g / |g|), exceeds it feels that part scaled by
+//   gravity, s_lin a_b . d (d = g / |g|; a_b over the last two fixed steps,
+//   (V - V_earlier) / 2 step, where the step is given), exceeds it feels that part scaled by
 //   bound / (s_lin a_b . d) more: the impulse's and the air's parts along d take
 //   s_fall = s_lin bound / (s_lin a_b . d), their other parts s_lin.
 // - Symplectic Euler: u += h du/dt, r += h u; then back to the world with the frame at the
@@ -50,7 +51,9 @@ struct AnchorMotion {
     Vec3 velocity_m_s = Vec3::Zero();                   ///< V.
     Vec3 angular_velocity_rad_s = Vec3::Zero();         ///< W.
     Vec3 velocity_before_m_s = Vec3::Zero();            ///< V_prev.
+    Vec3 velocity_earlier_m_s = Vec3::Zero();           ///< V one step before V_prev (InertiaScales::max_fall_m_s2 with step_s > 0).
     Vec3 angular_velocity_before_rad_s = Vec3::Zero();  ///< W_prev.
+    Real step_s = 0;                                    ///< The fixed step V - V_prev spans; > 0: the fall bound's acceleration is (V - V_earlier) / (2 step_s).
     Vec3 acceleration_m_s2 = Vec3::Zero();              ///< a_b; read only for InertiaScales::max_linear_m_s2 and max_fall_m_s2 (its inertial term acts through V - V_prev, and the drag no longer takes a_b h/2: docs/cloth.md, Integration).
 };
 

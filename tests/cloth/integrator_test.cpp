@@ -384,6 +384,37 @@ TEST(AnchorFrame, AFallBoundCarriesTheDownwardJerkBeyondItOnly) {
     EXPECT_NEAR(x(1, 0), -standard_gravity_m_s2 * h * h, 1e-6);
 }
 
+// The fall bound judges the root's acceleration over its last two steps (AnchorMotion::step_s
+// set, as the solver sets it): a clip keyed at 30 Hz and played at 60 moves its root every
+// other step, so a walk's hips that gain 0.3 m/s downward in one step and none in the next
+// fall at 9 m/s^2 (under g, felt whole), not 18 (bound, partly carried); a root that gains
+// 0.5 m/s downward in each of two steps falls at 30 m/s^2, and the step's change beyond the
+// bound is carried.
+TEST(AnchorFrame, AFallBoundJudgesTheFallOverTwoSteps) {
+    const Real h = Real(1.0 / 60.0), gh = standard_gravity_m_s2 * h;
+    const Vec3 g(0, -standard_gravity_m_s2, 0);
+    const VectorX inv_mass = VectorX::Constant(1, 100), drag = VectorX::Zero(1);
+    const InertiaScales free_fall{1, 1, 0, standard_gravity_m_s2};
+    const auto step = [&](Real earlier, Real before, Real after, Real step_s) {
+        Matrix3X x = Matrix3X::Zero(3, 1), v(3, 1);
+        v.col(0) = Vec3(0, before, 0);
+        AnchorMotion m;
+        m.velocity_earlier_m_s = Vec3(0, earlier, 0);
+        m.velocity_before_m_s = Vec3(0, before, 0);
+        m.velocity_m_s = Vec3(0, after, 0);
+        m.c1 = m.velocity_m_s * h;
+        m.step_s = step_s;
+        m.acceleration_m_s2 = (m.velocity_m_s - m.velocity_before_m_s) / h;
+        predict_particles(x, v, inv_mass, drag, 0, 1, m, free_fall, g, h);
+        return v(1, 0);
+    };
+    EXPECT_NEAR(step(0, 0, Real(-0.3), h), -gh, 1e-4) << "9 m/s^2 over two steps: felt whole, the particle left behind";
+    const Real one_step_carried = Real(0.3) * (1 - standard_gravity_m_s2 / (Real(0.3) / h));
+    EXPECT_NEAR(step(0, 0, Real(-0.3), 0), -one_step_carried - gh, 1e-4) << "judged over one step it binds";
+    const Real carried = Real(0.5) * (1 - standard_gravity_m_s2 / Real(30));
+    EXPECT_NEAR(step(0, Real(-0.5), -1, h), Real(-0.5) - carried - gh, 1e-4) << "30 m/s^2 over two steps: the excess carried";
+}
+
 // A frame accelerating steadily (a, no turn) with linear inertia scale s, under gravity, no
 // drag: relative to the frame the particle feels g - s a, so over t it moves
 //   r(t) - r(0) = u0 t + (g - s a) t^2 / 2,   u0 = v0 - V(0),
