@@ -121,6 +121,13 @@ bool render_available() noexcept {
 
 namespace {
 
+// Submesh `k` of `skin` not drawn (nothing for an index past its submeshes).
+void hide_submesh(SkinnedMesh& skin, std::size_t k) {
+    if (k >= skin.mesh->submeshes.size()) return;
+    skin.hidden.resize(skin.mesh->submeshes.size(), 0);
+    skin.hidden[k] = 1;
+}
+
 /// How far to raise a character placed by `t` so that its lowest point in the bind pose
 /// rests on the floor, when that point lies more than a tenth of its height from its
 /// origin's level (a file whose origin is at its feet, soles a little below or above it,
@@ -261,11 +268,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         world.garments.push_back(*garment);
         // A mesh of the character's own file that is now cloth is not drawn skinned too.
         if (auto* skin = world.registry.try_get<SkinnedMesh>(body); skin && skin->mesh)
-            for (const std::size_t k : own)
-                if (k < skin->mesh->submeshes.size()) {
-                    skin->hidden.resize(skin->mesh->submeshes.size(), 0);
-                    skin->hidden[k] = 1;
-                }
+            for (const std::size_t k : own) hide_submesh(*skin, k);
     }
     // A garment simulated over one modelled into the file: the modelled one is not drawn.
     for (std::size_t i = 0; i < scene.characters.size(); ++i) {
@@ -275,10 +278,7 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
         auto* skin = world.registry.try_get<SkinnedMesh>(world.characters[i]);
         if (!dressed || !c.hide_modelled_garments || skin == nullptr || !skin->mesh) continue;
         for (const LeftOutMesh& part : loaded.at({c.file, c.thicken_thin_trunk_m}).body.left_out)
-            if (part.garment && part.mesh < skin->mesh->submeshes.size()) {
-                skin->hidden.resize(skin->mesh->submeshes.size(), 0);
-                skin->hidden[part.mesh] = 1;
-            }
+            if (part.garment) hide_submesh(*skin, part.mesh);
     }
     settle_garments(world);
     world.watch = GarmentWatch(world.registry, world.garments, options.skin_penetration ? options.skin_penetration_every : 0);

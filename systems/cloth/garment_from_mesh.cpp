@@ -17,6 +17,7 @@
 #include "drape/engine/assets/skinning.hpp"
 #include "drape/systems/character/skin_surface.hpp"
 #include "drape/systems/character/trunk_skin.hpp"
+#include "drape/systems/cloth/body.hpp"
 #include "drape/systems/cloth/garment_surface.hpp"
 #include "drape/components/transform.hpp"
 
@@ -494,15 +495,17 @@ Result<void> check_garment_units(const GarmentMeshAsset& mesh, Real height_m, st
 GarmentPlacement measure_garment_placement(Registry& registry, Entity character, const GridGarment& grid) {
     GarmentPlacement out;
     struct Body {
-        Affine3 to_unit;
+        Mat3 to_unit;  // world offset from the centre -> unit sphere
         Vec3 center;
         bool trunk;
     };
     std::vector<Body> bodies;
-    registry.view<EllipsoidCollider>().each([&](Entity, const EllipsoidCollider& c) {
-        if (c.character != character || !c.placed) return;
-        bodies.push_back({c.world.inverse(), c.world.translation(), c.region == BodyRegion::pelvis || c.region == BodyRegion::torso});
-    });
+    for (const Entity e : character_colliders(registry, character)) {
+        const auto& c = registry.get<EllipsoidCollider>(e);
+        const EllipsoidFrame f = make_ellipsoid_frame(c.world);
+        if (c.placed && f.active)
+            bodies.push_back({f.to_unit, f.center, c.region == BodyRegion::pelvis || c.region == BodyRegion::torso});
+    }
     const auto cells = static_cast<Eigen::Index>(grid.grid_positions.cols());
     if (bodies.empty() || cells == 0 || grid.pinned.size() != static_cast<std::size_t>(cells)) return out;
     const auto* transform = registry.try_get<Transform>(character);
@@ -516,7 +519,7 @@ GarmentPlacement measure_garment_placement(Registry& registry, Entity character,
         // in the deepest one (its unit sphere's radius through the point).
         Real nearest = std::numeric_limits<Real>::infinity(), deepest = nearest;
         for (const Body& b : bodies) {
-            const Real s = (b.to_unit * p).norm();
+            const Real s = (b.to_unit * (p - b.center)).norm();
             nearest = std::min(nearest, s <= 1 ? Real(0) : (p - b.center).norm() * (1 - 1 / s));
             deepest = std::min(deepest, s);
         }
