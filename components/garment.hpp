@@ -160,6 +160,10 @@ struct GarmentConfig {
     CollisionMode collision = CollisionMode::candidate_lists;
     ClothMaterial material;
     InertiaScales inertia;
+    /// > 0: every particle hung from a pin stays within this x the rest length of its line
+    /// up to that pin of where it hangs in the rest shape, carried by the anchor (the max
+    /// distance of Unity Cloth, NvCloth's motion constraints; docs/cloth.md). 0: none.
+    Real max_distance_share = 0;
     Vec3 color = Vec3(0.75f, 0.12f, 0.18f);  ///< Linear RGB.
     friend bool operator==(const GarmentConfig&, const GarmentConfig&) = default;
 };

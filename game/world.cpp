@@ -58,7 +58,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
                                    const CharacterAsset& asset, const CharacterBody& fit, std::vector<std::size_t>& own) {
     for (const GarmentParameter& p : g.parameters) {
         const GarmentParameterSpec* spec = find_garment_parameter(p.name);
-        if (p.name != "weft_stride" && p.name != "fitting_rows" && !p.name.starts_with("inertia_") && !(spec && spec->in_material()))
+        if (p.name != "weft_stride" && p.name != "fitting_rows" && !p.name.starts_with("inertia_") && p.name != "max_distance_share" && !(spec && spec->in_material()))
             return fail(field + "." + p.name + ": shapes a built-in garment; a garment from a file has its own shape");
     }
     MeshGarmentParams mp;
@@ -72,6 +72,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
     mp.config.collision = params.collision;
     mp.config.material = params.material;
     mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular, params.inertia_max_linear_m_s2, params.inertia_max_fall_m_s2};
+    mp.config.max_distance_share = params.max_distance_share;
     mp.config.color = params.color;
     mp.pin_weights = params.pin_weights;
     std::error_code ec;

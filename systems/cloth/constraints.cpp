@@ -452,6 +452,28 @@ void solve_tethers(const Tethers& t, Matrix3XRows& x) {
     }
 }
 
+void solve_max_distance(const Tethers& t, const Matrix3X& rest_local, const Affine3& anchor, Real share, Matrix3XRows& x) {
+    if (!(share > 0)) return;
+    Real* x0 = x.row(0).data();
+    Real* x1 = x.row(1).data();
+    Real* x2 = x.row(2).data();
+    const Mat3 r = anchor.linear();
+    const Vec3 c = anchor.translation();
+    for (std::size_t k = 0; k < t.particle.size(); ++k) {
+        const std::uint32_t p = t.particle[k];
+        if (static_cast<Eigen::Index>(p) >= rest_local.cols()) continue;
+        const Vec3 target = r * rest_local.col(p) + c;
+        const Real d0 = x0[p] - target[0], d1 = x1[p] - target[1], d2 = x2[p] - target[2];
+        const Real radius = share * t.length_m[k];
+        const Real distance_sq = d0 * d0 + d1 * d1 + d2 * d2;
+        if (distance_sq <= radius * radius) continue;
+        const Real scale = radius / std::sqrt(distance_sq);
+        x0[p] = target[0] + d0 * scale;
+        x1[p] = target[1] + d1 * scale;
+        x2[p] = target[2] + d2 * scale;
+    }
+}
+
 std::uint64_t limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real stretch, Matrix3X& x,
                                Matrix3X& moves, std::uint32_t first_line, std::uint32_t end_line) {
     std::uint64_t moved = 0;

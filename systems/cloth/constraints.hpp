@@ -13,6 +13,8 @@
 //      times 1 + limit_share x limit; long-range attachments, as Jolt
 //      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
 //      line's weight up to its pin, the tether does it in one).
+//   3. With a max distance (GarmentConfig::max_distance_share), each tethered particle back
+//      within its sphere round its rest place carried by the anchor (solve_max_distance).
 // After the rounds, once per substep, limit_warp_lines holds every warp spring within half
 // the limit by a one-sided pass from the pins down (follow the leader), then
 // limit_weft_rows holds every weft row the same, each run of over-long springs solved as
@@ -133,6 +135,15 @@ struct Tethers {
 
 /// One pass over the tethers (step 2).
 void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
+
+/// The max distance (GarmentConfig::max_distance_share > 0; step 3, after the tethers): each
+/// tethered particle stays within `share` x its tether's length of its place in the rest
+/// shape carried by the anchor, `anchor * rest_local.col(p)` (as Unity Cloth's max distance
+/// and NvCloth's motion constraints keep a particle within a sphere round its skinned
+/// place): a particle outside that sphere is moved onto it. At share 1 the hem may swing
+/// 60 degrees from where it hangs at rest, but not up past its pins.
+void solve_max_distance(const Tethers& tethers, const Matrix3X& rest_local, const Affine3& anchor, Real share,
+                        Matrix3XRows& x);
 
 /// After the rounds: the warp limit (Provot's rule for a fixed end, method §4.1). Row after
 /// row from the fitting zone down, a free particle farther than (1 + stretch) x rest from

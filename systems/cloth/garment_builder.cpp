@@ -459,6 +459,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.integrator, s.collision, s.color);
     g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular, s.inertia_max_linear_m_s2, s.inertia_max_fall_m_s2};
+    g.config.max_distance_share = s.max_distance_share;
     g.body.character = character;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
     std::size_t anchor = outline.front();
@@ -685,6 +686,7 @@ Result<Entity> attach_grid_garment(Registry& registry, Entity character, const G
     const GarmentConfig& c = grid.config;
     Garment g = make_instance(*topology, to_particle_order(**topology, world), c.material, c.model, c.integrator, c.collision, c.color);
     g.config.inertia = c.inertia;
+    g.config.max_distance_share = c.max_distance_share;
     g.body.character = character;
 
     // Where it is held: the pins' centre. Held between the midpoint of the waist and the

@@ -141,6 +141,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "> 0: the most of the body's linear acceleration the cloth feels (x `inertia_linear`); beyond it the rest is carried rigidly (an animated jump stopping dead at its top); 0: no bound"),
         real("inertia_max_fall_m_s2", &TubeParams::inertia_max_fall_m_s2, closed(0, 1e4), "m/s^2",
              "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall); the downward part beyond it is carried rigidly; 0: no bound"),
+        real("max_distance_share", &TubeParams::max_distance_share, closed(0, 10), "",
+             "> 0: each particle stays within this x the rest length of its line up to its pin of where it hangs in the rest shape, carried by the body (a max distance, as Unity Cloth's; 1: the hem swings up to 60 degrees, never past its pins); 0: none"),
         real("thin_trunk_piece_m", &TubeParams::thin_trunk_piece_m, closed(0, 1), "m",
              "> 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is at most this (pieces that stand between neighbouring particles and hold the cloth open; the anchor's kept); 0: with every ellipsoid"),
         real("areal_density_kg_m2", &ClothMaterial::areal_density_kg_m2, open_min(0, 10), "kg/m^2",

@@ -148,6 +148,11 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
     // before a collision round (and so after the last round).
     const bool in_rows = round > 0 && !collides_after(round - 1, rounds);
     const bool write_back = collides_after(round, rounds) || tethers;
+    // The max distance's spheres round the rest shape as the anchor carries it at the end of
+    // the substep (prepare_collision placed the colliders there).
+    const Real max_distance = g.config.max_distance_share;
+    const bool spheres = tethers && max_distance > 0 && g.body.rest_local.cols() == x.cols();
+    const Affine3 anchor = spheres ? anchor_frame(s.frames, g.body.anchor) : Affine3::Identity();
     // The springs joining two bands first, on this thread (none in a garment of one band).
     for (SpringSet& set : s.springs) {
         if (in_rows)
@@ -169,6 +174,7 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
                     set, k, s.x_rows, s.inv_mass, h, g.config.material.line_iterations, g.config.material.line_tolerance));
         }
         if (tethers) solve_tethers(s.tethers[k], s.x_rows);
+        if (spheres) solve_max_distance(s.tethers[k], g.body.rest_local, anchor, max_distance, s.x_rows);
         if (write_back)
             for (const ParticleRun& r : s.parts.runs[k])
                 x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);

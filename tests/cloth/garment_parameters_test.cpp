@@ -23,12 +23,13 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
     // Every ClothMaterial field a garment carries is a row (12 of them), and so is every
-    // numeric field of TubeParams (16, the inertia scales with their acceleration and fall
-    // bounds, the hem clearance and the line spacing included).
+    // numeric field of TubeParams (19, the inertia scales with their acceleration and fall
+    // bounds, the max distance, the hem clearance, the line spacing and the thin trunk
+    // pieces included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
     EXPECT_EQ(material, 12);
-    EXPECT_EQ(garment_parameters().size(), 30u);
+    EXPECT_EQ(garment_parameters().size(), 31u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {

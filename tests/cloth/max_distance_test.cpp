@@ -1,0 +1,55 @@
+// The max distance (GarmentConfig::max_distance_share; constraints.hpp solve_max_distance):
+// each particle hung from a pin is kept within share x its tether's length of its place in
+// the rest shape, as the anchor carries that shape.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "drape/systems/cloth/constraints.hpp"
+
+namespace drape {
+namespace {
+
+TEST(MaxDistance, AParticleOutsideItsSphereGoesOntoItOneInsideStays) {
+    // Three particles: 0 is the pin, 1 and 2 hang 0.2 m and 0.5 m below it on its line.
+    Matrix3X rest_local(3, 3);
+    rest_local << 0, 0, 0,
+                  0, Real(-0.2), Real(-0.5),
+                  0, 0, 0;
+    Tethers tethers;
+    tethers.particle = {1, 2};
+    tethers.anchor = {0, 0};
+    tethers.length_m = {Real(0.2), Real(0.5)};
+    // The anchor turned a quarter turn about z and moved: the rest places go with it.
+    Affine3 anchor = Affine3::Identity();
+    anchor.translate(Vec3(1, 2, 3));
+    anchor.rotate(Eigen::AngleAxis<Real>(std::numbers::pi_v<Real> / 2, Vec3::UnitZ()));
+    const Vec3 place1 = anchor * Vec3(rest_local.col(1)), place2 = anchor * Vec3(rest_local.col(2));
+    EXPECT_TRUE(place1.isApprox(Vec3(Real(1.2), 2, 3), Real(1e-5)));
+
+    Matrix3XRows x(3, 3);
+    x.col(0) = anchor * Vec3(rest_local.col(0));
+    x.col(1) = place1 + Vec3(0, Real(0.1), 0);  // 0.1 m from its place: inside 0.2
+    x.col(2) = place2 + Vec3(0, Real(0.9), 0);  // 0.9 m above its place: outside 0.5, above the pin
+    const Vec3 x1 = x.col(1);
+    solve_max_distance(tethers, rest_local, anchor, 1, x);
+    EXPECT_TRUE(Vec3(x.col(1)).isApprox(x1));
+    EXPECT_NEAR((Vec3(x.col(2)) - place2).norm(), 0.5, 1e-5);
+    EXPECT_TRUE((Vec3(x.col(2)) - place2).normalized().isApprox(Vec3::UnitY(), Real(1e-5)));  // along the way it was
+    EXPECT_TRUE(Vec3(x.col(0)).isApprox(anchor * Vec3(rest_local.col(0))));  // the pin is no tether's particle
+
+    // Half the share: the sphere is half as wide.
+    x.col(2) = place2 + Vec3(Real(0.6), 0, 0);
+    solve_max_distance(tethers, rest_local, anchor, Real(0.5), x);
+    EXPECT_NEAR((Vec3(x.col(2)) - place2).norm(), 0.25, 1e-5);
+    EXPECT_NEAR((Vec3(x.col(1)) - place1).norm(), 0.1, 1e-5);  // within 0.1 still
+
+    // Share 0 is off.
+    x.col(2) = place2 + Vec3(0, 5, 0);
+    solve_max_distance(tethers, rest_local, anchor, 0, x);
+    EXPECT_NEAR((Vec3(x.col(2)) - place2).norm(), 5, 1e-4);
+}
+
+}  // namespace
+}  // namespace drape
