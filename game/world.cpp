@@ -67,13 +67,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
     mp.weft_stride = params.weft_stride;
     mp.pins = g.pins;
     mp.fitting_rows = params.fitting_rows;
-    mp.config.model = params.model;
-    mp.config.integrator = params.integrator;
-    mp.config.collision = params.collision;
-    mp.config.material = params.material;
-    mp.config.inertia = InertiaScales{params.inertia_linear, params.inertia_angular, params.inertia_max_linear_m_s2, params.inertia_max_fall_m_s2};
-    mp.config.max_distance_share = params.max_distance_share;
-    mp.config.color = params.color;
+    mp.config = garment_config(params);
     mp.pin_weights = params.pin_weights;
     std::error_code ec;
     if (fs::equivalent(g.file, character, ec)) {

@@ -453,7 +453,7 @@ void solve_tethers(const Tethers& t, Matrix3XRows& x) {
 }
 
 void solve_max_distance(const Tethers& t, const Matrix3X& rest_local, const Affine3& anchor, Real share, Matrix3XRows& x) {
-    if (!(share > 0)) return;
+    if (!(share > 0) || rest_local.cols() == 0) return;  // a rest shape is one column per particle
     Real* x0 = x.row(0).data();
     Real* x1 = x.row(1).data();
     Real* x2 = x.row(2).data();
@@ -461,7 +461,6 @@ void solve_max_distance(const Tethers& t, const Matrix3X& rest_local, const Affi
     const Vec3 c = anchor.translation();
     for (std::size_t k = 0; k < t.particle.size(); ++k) {
         const std::uint32_t p = t.particle[k];
-        if (static_cast<Eigen::Index>(p) >= rest_local.cols()) continue;
         const Vec3 target = r * rest_local.col(p) + c;
         const Real d0 = x0[p] - target[0], d1 = x1[p] - target[1], d2 = x2[p] - target[2];
         const Real radius = share * t.length_m[k];

@@ -141,7 +141,8 @@ void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 /// shape carried by the anchor, `anchor * rest_local.col(p)` (as Unity Cloth's max distance
 /// and NvCloth's motion constraints keep a particle within a sphere round its skinned
 /// place): a particle outside that sphere is moved onto it. At share 1 the hem may swing
-/// 60 degrees from where it hangs at rest, but not up past its pins.
+/// 60 degrees from where it hangs at rest, but not up past its pins. `rest_local` holds a
+/// column per particle of `x` (or none: nothing is done).
 void solve_max_distance(const Tethers& tethers, const Matrix3X& rest_local, const Affine3& anchor, Real share,
                         Matrix3XRows& x);
 

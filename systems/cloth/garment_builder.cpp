@@ -96,6 +96,22 @@ Garment make_instance(std::shared_ptr<const Fabric> fabric, Matrix3X x, const Cl
     return g;
 }
 
+}  // namespace
+
+GarmentConfig garment_config(const TubeParams& p) {
+    GarmentConfig c;
+    c.model = p.model;
+    c.integrator = p.integrator;
+    c.collision = p.collision;
+    c.material = p.material;
+    c.inertia = InertiaScales{p.inertia_linear, p.inertia_angular, p.inertia_max_linear_m_s2, p.inertia_max_fall_m_s2};
+    c.max_distance_share = p.max_distance_share;
+    c.color = p.color;
+    return c;
+}
+
+namespace {
+
 // Vertical half extent of an ellipsoid (its axis-aligned box).
 Real half_height(const EllipsoidFrame& f) { return (f.rotation * f.radii_m.asDiagonal()).row(1).norm(); }
 
@@ -458,8 +474,7 @@ Result<Entity> attach_tube(Registry& registry, Entity character, std::string_vie
     auto topology = build_grid_topology(n, m, s.weft_stride, true, grid, name);
     if (!topology) return std::unexpected(topology.error());
     Garment g = make_instance(*topology, to_particle_order(**topology, grid), s.material, s.model, s.integrator, s.collision, s.color);
-    g.config.inertia = InertiaScales{s.inertia_linear, s.inertia_angular, s.inertia_max_linear_m_s2, s.inertia_max_fall_m_s2};
-    g.config.max_distance_share = s.max_distance_share;
+    g.config = garment_config(s);
     g.body.character = character;
     // Anchor: the outline collider nearest the axis at the ring height (pelvis, chest).
     std::size_t anchor = outline.front();
@@ -685,8 +700,7 @@ Result<Entity> attach_grid_garment(Registry& registry, Entity character, const G
     if (!topology) return std::unexpected(topology.error());
     const GarmentConfig& c = grid.config;
     Garment g = make_instance(*topology, to_particle_order(**topology, world), c.material, c.model, c.integrator, c.collision, c.color);
-    g.config.inertia = c.inertia;
-    g.config.max_distance_share = c.max_distance_share;
+    g.config = c;
     g.body.character = character;
 
     // Where it is held: the pins' centre. Held between the midpoint of the waist and the

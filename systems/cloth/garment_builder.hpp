@@ -102,6 +102,10 @@ struct TubeParams {
     }
 };
 
+/// The configuration a garment built from `params` runs with (its model, integrator,
+/// collision, material, inertia, max distance and colour).
+[[nodiscard]] GarmentConfig garment_config(const TubeParams& params);
+
 /// A flat rectangle (tests, demos): lines along +X, rows down -Y (hanging) or along +Z (lying).
 struct RectangleParams {
     int warp_lines = 16;              ///< (warp_lines - 1) must be a multiple of weft_stride.
