@@ -66,17 +66,19 @@ Result<TubeParams> tube_params(const GarmentDescription& garment) {
 
 std::string garment_parameters_markdown() {
     const TubeParams skirt = TubeParams::skirt(), dress = TubeParams::dress();
-    std::string out = "| parameter | range | skirt | dress | meaning |\n|---|---|---|---|---|\n";
-    auto row = [&](const ParameterSpec& spec, double skirt_default, double dress_default) {
+    std::string out = "| parameter | range | skirt | dress | file | meaning |\n|---|---|---|---|---|---|\n";
+    auto row = [&](const ParameterSpec& spec, double skirt_default, double dress_default, bool file) {
         out += "| `";
         out += spec.name;
         out += "` | " + spec.range_text() + " | " + parameter_number_text(skirt_default) + " | " +
-               parameter_number_text(dress_default) + " | ";
+               parameter_number_text(dress_default) + " | " + (file ? "yes" : "") + " | ";
         out += spec.description;
         out += " |\n";
     };
-    row(particles_parameter(), double(skirt.warp_lines) * skirt.particles_per_line, double(dress.warp_lines) * dress.particles_per_line);
-    for (const GarmentParameterSpec& spec : garment_parameters()) row(spec, spec.get(skirt), spec.get(dress));
+    row(particles_parameter(), double(skirt.warp_lines) * skirt.particles_per_line, double(dress.warp_lines) * dress.particles_per_line,
+        false);
+    for (const GarmentParameterSpec& spec : garment_parameters())
+        row(spec, spec.get(skirt), spec.get(dress), spec.takes_file_garments());
     return out;
 }
 

@@ -31,8 +31,9 @@ namespace drape {
 [[nodiscard]] Result<TubeParams> tube_params(const GarmentDescription& garment);
 
 /// The garment parameter table of docs/scenes.md, Markdown, one row per parameter:
-/// name, range (with unit), skirt and dress defaults, meaning. `drape scene-parameters`
-/// prints it; a test checks that docs/scenes.md holds exactly this.
+/// name, range (with unit), skirt and dress defaults, whether a garment from a file takes
+/// it, meaning. `drape scene-parameters` prints it; a test checks that docs/scenes.md holds
+/// exactly this.
 [[nodiscard]] std::string garment_parameters_markdown();
 
 }  // namespace drape

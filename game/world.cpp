@@ -58,7 +58,7 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
                                    const CharacterAsset& asset, const CharacterBody& fit, std::vector<std::size_t>& own) {
     for (const GarmentParameter& p : g.parameters) {
         const GarmentParameterSpec* spec = find_garment_parameter(p.name);
-        if (p.name != "weft_stride" && p.name != "fitting_rows" && !p.name.starts_with("inertia_") && p.name != "max_distance_share" && !(spec && spec->in_material()))
+        if (spec == nullptr || !spec->takes_file_garments())
             return fail(field + "." + p.name + ": shapes a built-in garment; a garment from a file has its own shape");
     }
     MeshGarmentParams mp;

@@ -98,6 +98,12 @@ GarmentParameterSpec real(std::string_view name, Real Owner::*field, ParameterRa
     return GarmentParameterSpec{{name, ParameterKind::real, range, unit, description}, field};
 }
 
+// A row a garment from a file takes too (GarmentParameterSpec::file_garments).
+GarmentParameterSpec for_file_garments(GarmentParameterSpec spec) {
+    spec.file_garments = true;
+    return spec;
+}
+
 ParameterRange closed(double min, double max) { return {min, max, false, false}; }
 ParameterRange open_min(double min, double max) { return {min, max, true, false}; }  // (min, max]
 ParameterRange open_max(double min, double max) { return {min, max, false, true}; }  // [min, max)
@@ -114,8 +120,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
                 "lines around the body; a multiple of `weft_stride`"),
         integer("particles_per_line", &TubeParams::particles_per_line, closed(2, max_side),
                 "particles down each line; `warp_lines` x `particles_per_line` is at most the `particles` limit"),
-        integer("weft_stride", &TubeParams::weft_stride, closed(1, max_side - 1),
-                "every n-th line is integrated, the lines between are placed (method §3.2); less than `warp_lines`"),
+        for_file_garments(integer("weft_stride", &TubeParams::weft_stride, closed(1, max_side - 1),
+                                  "every n-th line is integrated, the lines between are placed (method §3.2); less than `warp_lines`")),
         real("line_spacing_m", &TubeParams::line_spacing_m, closed(0, 1), "m",
              "> 0: on a wider body more lines, at most this far apart round the ring (never fewer than `warp_lines`); 0: `warp_lines` as given"),
         real("hem_spacing_leg_widths", &TubeParams::hem_spacing_leg_widths, closed(0, 100), "",
@@ -131,18 +137,18 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "> 0: ring height above the body's lowest point (0: from `ring_height_fraction`)"),
         real("torso_radius_fraction", &TubeParams::torso_radius_fraction, open_min(0, 1), "",
              "colliders farther from the body axis than this x body height (arms) are not part of the outline at the ring"),
-        integer("fitting_rows", &TubeParams::fitting_rows, closed(1, max_side - 1),
-                "rows pinned to the body (method §3.5); fewer than `particles_per_line`"),
-        real("inertia_linear", &TubeParams::inertia_linear, closed(0, 1), "",
-             "how much of the body's linear acceleration the cloth feels (method §3.3's -m a_body): 1 physical, 0 carried rigidly"),
-        real("inertia_angular", &TubeParams::inertia_angular, closed(0, 1), "",
-             "how much of the body's turning the cloth feels (centrifugal, Coriolis): 1 physical, 0 carried rigidly"),
-        real("inertia_max_linear_m_s2", &TubeParams::inertia_max_linear_m_s2, closed(0, 1e4), "m/s^2",
-             "> 0: the most of the body's linear acceleration the cloth feels (x `inertia_linear`); beyond it the rest is carried rigidly (an animated jump stopping dead at its top); 0: no bound"),
-        real("inertia_max_fall_m_s2", &TubeParams::inertia_max_fall_m_s2, closed(0, 1e4), "m/s^2",
-             "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall); the downward part beyond it is carried rigidly; 0: no bound"),
-        real("max_distance_share", &TubeParams::max_distance_share, closed(0, 10), "",
-             "> 0: each particle stays within this x the rest length of its line up to its pin of where it hangs in the rest shape, carried by the body (a max distance, as Unity Cloth's; 1: the hem swings up to 60 degrees, never past its pins); 0: none"),
+        for_file_garments(integer("fitting_rows", &TubeParams::fitting_rows, closed(1, max_side - 1),
+                                  "rows pinned to the body (method §3.5); fewer than `particles_per_line`")),
+        for_file_garments(real("inertia_linear", &TubeParams::inertia_linear, closed(0, 1), "",
+                               "how much of the body's linear acceleration the cloth feels (method §3.3's -m a_body): 1 physical, 0 carried rigidly")),
+        for_file_garments(real("inertia_angular", &TubeParams::inertia_angular, closed(0, 1), "",
+                               "how much of the body's turning the cloth feels (centrifugal, Coriolis): 1 physical, 0 carried rigidly")),
+        for_file_garments(real("inertia_max_linear_m_s2", &TubeParams::inertia_max_linear_m_s2, closed(0, 1e4), "m/s^2",
+                               "> 0: the most of the body's linear acceleration the cloth feels (x `inertia_linear`); beyond it the rest is carried rigidly (an animated jump stopping dead at its top); 0: no bound")),
+        for_file_garments(real("inertia_max_fall_m_s2", &TubeParams::inertia_max_fall_m_s2, closed(0, 1e4), "m/s^2",
+                               "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall); the downward part beyond it is carried rigidly; 0: no bound")),
+        for_file_garments(real("max_distance_share", &TubeParams::max_distance_share, closed(0, 10), "",
+                               "> 0: each particle stays within this x the rest length of its line up to its pin of where it hangs in the rest shape, carried by the body (a max distance, as Unity Cloth's; 1: the hem swings up to 60 degrees, never past its pins); 0: none")),
         real("thin_trunk_piece_m", &TubeParams::thin_trunk_piece_m, closed(0, 1), "m",
              "> 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is at most this (pieces that stand between neighbouring particles and hold the cloth open; the anchor's kept); 0: with every ellipsoid"),
         real("areal_density_kg_m2", &ClothMaterial::areal_density_kg_m2, open_min(0, 10), "kg/m^2",

@@ -59,9 +59,15 @@ using GarmentParameterMember =
 /// One row of the table: a parameter and the field it sets.
 struct GarmentParameterSpec : ParameterSpec {
     GarmentParameterMember member;
+    /// True where a garment from a file (docs/garments.md) takes the parameter too: how its
+    /// grid is integrated and held, and how it moves; not a built-in tube's shape or the
+    /// colliders its builder leaves out. Every material field is taken: see takes_file_garments().
+    bool file_garments = false;
 
     /// True for the fields of TubeParams::material.
     [[nodiscard]] bool in_material() const noexcept;
+    /// Whether a garment from a file takes the parameter: file_garments or a material field.
+    [[nodiscard]] bool takes_file_garments() const noexcept { return file_garments || in_material(); }
     /// The field as the builder's messages name it: "length_m", "material.areal_density_kg_m2".
     [[nodiscard]] std::string field() const;
     /// The field's value in `params`.
