@@ -123,7 +123,7 @@ void add_bench_command(CLI::App& app) {
     command->add_option("--threads", cli->threads, "Worker threads for parallel systems (default 1)")->check(CLI::Range(1, 256));
     command->add_option("--filter", cli->filter, "Only the cases whose name holds every comma-separated word (motions, garments, cut, stability)");
     command->add_option("--garment-param", cli->garment_params,
-                        "NAME=VALUE: a garment parameter (docs/scenes.md) for every garment instead of the shipped value (motions); "
+                        "NAME=VALUE: a garment parameter (docs/scenes.md) for every garment instead of the shipped value (motions, cut); "
                         "repeatable");
     command->add_option("--start", cli->start_s, "Seconds into the clip where every case starts (stability; default 0)")
         ->check(CLI::Range(0.0, 1000.0));
@@ -164,7 +164,7 @@ void add_bench_command(CLI::App& app) {
             bool given;
             const char* option;
             std::vector<std::string> takers;
-        } limited[] = {{!garment_parameters.empty(), "--garment-param", {"motions"}},
+        } limited[] = {{!garment_parameters.empty(), "--garment-param", {"motions", "cut"}},
                        {cli->start_s > 0, "--start", {"stability"}},
                        {!cli->warp_solve.empty(), "--warp-solve", {"motions", "stability"}},
                        {cli->thicken_thin_trunk_m > 0, "--thicken-thin-trunk", {"motions"}}};

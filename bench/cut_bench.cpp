@@ -65,6 +65,7 @@ Result<void> run_cut(const BenchOptions& options) {
                 scene.garments.emplace_back();
                 scene.garments[0].type = type;
                 scene.garments[0].model = model;
+                for (const auto& [name, value] : options.garment_parameters) scene.garments[0].parameters.push_back({name, value});
                 scene.solver.threads = options.threads;
                 WorldOptions world_options;
                 world_options.profile = false;
@@ -93,7 +94,7 @@ Result<void> run_cut(const BenchOptions& options) {
     Report report("A garment's cut on a still body", once, describe_machine());
     report.paragraph(
         "Each character's garment put on in the first pose of its chosen clip (a walk where it has one), the clip then held "
-        "still for " + std::to_string(still_frames / 60) + " s, one thread, shipped settings. The hem's radius: the mean "
+        "still for " + std::to_string(still_frames / 60) + " s, one thread, shipped settings" + changed_parameters(options) + ". The hem's radius: the mean "
         "horizontal distance of each warp line's last particle from the centre of the fitting row, in the cut (the "
         "builder's rest shape), once put on, and after the still seconds. A flared garment hangs in folds, so its hem comes "
         "in from the cut in either model; the figure is how far the simplified model (stretch springs only) ends from the "

@@ -111,18 +111,6 @@ struct RunResult {
     }
 };
 
-// ", but NAME = VALUE, ..." for the garment parameters given instead of the shipped ones.
-std::string changed_parameters(const BenchOptions& options) {
-    std::string text;
-    for (const auto& [name, value] : options.garment_parameters)
-        text += (text.empty() ? " but " : ", ") + name + " = " + parameter_number_text(value);
-    if (options.warp_solve == WarpSolve::lines) text += (text.empty() ? " but " : ", ") + std::string("warp lines solved directly");
-    if (options.thicken_thin_trunk_m > 0)
-        text += (text.empty() ? " but " : ", ") + std::string("trunk pieces at most ") + parameter_number_text(options.thicken_thin_trunk_m) +
-                " m thin thickened inward";
-    return text;
-}
-
 struct RunOptions {
     int threads = 1;
     std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.

@@ -13,6 +13,8 @@
 
 #include <unistd.h>
 
+#include "drape/systems/cloth/garment_parameters.hpp"
+
 namespace drape::bench {
 
 namespace {
@@ -41,6 +43,17 @@ bool have_program(const std::string& program) {
 }
 
 }  // namespace
+
+std::string changed_parameters(const BenchOptions& options) {
+    std::string text;
+    for (const auto& [name, value] : options.garment_parameters)
+        text += (text.empty() ? " but " : ", ") + name + " = " + parameter_number_text(value);
+    if (options.warp_solve == WarpSolve::lines) text += (text.empty() ? " but " : ", ") + std::string("warp lines solved directly");
+    if (options.thicken_thin_trunk_m > 0)
+        text += (text.empty() ? " but " : ", ") + std::string("trunk pieces at most ") + parameter_number_text(options.thicken_thin_trunk_m) +
+                " m thin thickened inward";
+    return text;
+}
 
 std::string current_loadavg() {
     std::string line = read_first_line("/proc/loadavg");

@@ -31,7 +31,7 @@ struct BenchOptions {
     std::string command;                       ///< The command line that reproduces the run.
     std::string filter;                        ///< Comma-separated words a case's name must hold (benchmarks that list cases).
     /// Garment parameters (docs/scenes.md's table: name, value) given to every garment of the
-    /// runs instead of the shipped values (`--garment-param NAME=VALUE`; motions only).
+    /// runs instead of the shipped values (`--garment-param NAME=VALUE`; motions and cut only).
     std::vector<std::pair<std::string, double>> garment_parameters;
     /// Where in its clip every case starts, s (`--start`; stability only).
     double start_s = 0;
@@ -55,6 +55,9 @@ struct Machine {
 };
 
 [[nodiscard]] Machine describe_machine();
+/// ", but NAME = VALUE, ..." for the settings `options` changes from the shipped ones
+/// (garment parameters, the warp solve, the body fit's thickening); empty when none.
+[[nodiscard]] std::string changed_parameters(const BenchOptions& options);
 /// Current /proc/loadavg (first three fields), or "unavailable".
 [[nodiscard]] std::string current_loadavg();
 

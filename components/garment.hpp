@@ -118,12 +118,13 @@ struct ClothMaterial {
     Real areal_density_kg_m2 = Real(0.17);  ///< Mass per area (cotton lawn / poplin: 0.1-0.2).
     Real stretch_N_m = Real(2000);          ///< Stretch modulus of warp and weft.
     Real shear_N_m = Real(100);             ///< Classic only: shear springs' modulus.
-    Real bend_N_m = Real(10);               ///< Classic only: bend springs' modulus.
+    Real bend_N_m = Real(10);               ///< Bend springs' modulus: classic; simplified with weft_bend.
     Real drag_N_s_m3 = Real(0.3);           ///< Air drag per area per speed (method §3.3 k = this x particle area).
     Real friction = Real(0.4);              ///< Coulomb coefficient of the cloth on the body.
     Real strain_limit = Real(0.10);         ///< Provot: max relative over-stretch (method §4.1).
     Real compression_limit = Real(0.25);    ///< Shortest a spring may be, over its rest length (0: none).
     int iterations = 4;                     ///< Constraint rounds per substep.
+    int weft_bend = 0;                      ///< Simplified model, 1: bend springs along its weft rows at bend_N_m (an extension).
     int line_iterations = 8;                ///< WarpSolve::lines: most Newton steps per line solve (round).
     Real line_tolerance = Real(0.001);      ///< WarpSolve::lines: a spring's residual strain that ends them.
     Real candidate_margin_m = Real(0.08);   ///< Candidate lists: reach beyond the surface (method §5).

@@ -36,6 +36,23 @@ SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus
     return set;
 }
 
+// Bend springs along the weft rows: the weft springs (a beside b) chained, each particle
+// joined to the second beside it, at their distance in the cut (Fabric::rest_shape, grid
+// order), sorted as the fabric's phases are (strips, constraints.hpp).
+SpringPhase weft_bends(const Fabric& t) {
+    std::vector<std::uint32_t> grid_of(t.particle_count());
+    for (std::size_t i = 0; i < t.grid.size(); ++i) grid_of[t.grid[i]] = static_cast<std::uint32_t>(i);
+    std::vector<std::uint32_t> right(t.particle_count(), no_spring);
+    for (std::size_t k = 0; k < t.weft.size(); ++k) right[t.weft.a[k]] = t.weft.b[k];
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t k = 0; k < t.weft.size(); ++k)
+        if (const std::uint32_t c = right[t.weft.b[k]]; c != no_spring && c != t.weft.a[k]) pairs.emplace_back(t.weft.a[k], c);
+    std::sort(pairs.begin(), pairs.end());
+    SpringPhase phase;
+    for (const auto& [a, c] : pairs) phase.add(a, c, (t.rest_shape.col(grid_of[c]) - t.rest_shape.col(grid_of[a])).norm());
+    return phase;
+}
+
 }  // namespace
 
 void prepare_solver(const Garment& g, GarmentSolver& s) {
@@ -63,6 +80,13 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.parts = make_parts(t, g.config.model, s.integrated);
         const GarmentParts& parts = s.parts;
         s.springs.clear();
+        s.weft_bend.reset();
+        if (simplified && m.weft_bend != 0) {
+            // Bending along the weft rows first, as the classic model's bend springs: the
+            // structural springs and their limit have the last word (docs/cloth.md "Weft bending").
+            s.weft_bend = std::make_shared<const SpringPhase>(weft_bends(t));
+            s.springs.push_back(spring_set(*s.weft_bend, area, m.bend_N_m, false, parts));
+        }
         if (simplified) {
             // Weft springs, then the warp: layer 1's (with the areas its particles stand for;
             // with lines their own, layer 2's lines carrying their own weight), then layer 2's.

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "drape/components/garment.hpp"
@@ -88,6 +89,9 @@ struct GarmentSolver {
     VectorX drag_N_s_m;                      ///< eq. 2's k per particle, with the same shares.
     GarmentParts parts;                      ///< The garment's work in fixed parts (garment_parts.hpp).
     std::vector<SpringSet> springs;          ///< The springs the model solves, in order.
+    /// Simplified model with ClothMaterial::weft_bend: each particle to the second beside it
+    /// on its weft row; `springs` points into it.
+    std::shared_ptr<const SpringPhase> weft_bend;
     std::vector<Tethers> tethers;            ///< Long-range attachments from the pins, per line band.
     std::vector<std::uint32_t> below;        ///< Per particle: the particle below it on its line (itself in the last row).
     std::vector<std::uint32_t> above;        ///< Per particle: the particle above it on its line (itself in the first row).
