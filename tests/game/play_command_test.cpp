@@ -152,7 +152,7 @@ TEST_F(PlayCommand, BenchGarmentParametersAreCheckedByName) {
          "drape bench: --garment-param warp_lines: must be in integer [2, 4096], got '2.5'\n"},
         {"bench motions --garment-param inertia_linear",
          "drape bench: --garment-param 'inertia_linear': give NAME=VALUE (drape scene-parameters lists the names)\n"},
-        {"bench quality --garment-param inertia_linear=0.5", "drape bench: --garment-param: only the motions benchmark takes it\n"},
+        {"bench quality --garment-param inertia_linear=0.5", "drape bench: --garment-param: only the motions and cut benchmarks take it\n"},
         {"bench motions --start 0.5", "drape bench: --start: only the stability benchmark takes it\n"},
         {"bench table1 --warp-solve lines", "drape bench: --warp-solve: only the motions and stability benchmarks take it\n"},
         {"bench quality --thicken-thin-trunk 0.015", "drape bench: --thicken-thin-trunk: only the motions benchmark takes it\n"},
