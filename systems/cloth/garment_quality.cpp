@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "drape/systems/cloth/body.hpp"
@@ -10,11 +11,23 @@
 
 namespace drape {
 
+namespace {
+
+std::size_t histogram_bin(Real strain) noexcept {
+    const Real s = std::isfinite(strain) ? std::max(strain, Real(0)) : Real(StrainHistogram::bins) * StrainHistogram::bin;
+    return std::min(StrainHistogram::bins - 1, static_cast<std::size_t>(s / StrainHistogram::bin));
+}
+
+}  // namespace
+
 void StrainHistogram::add(Real strain) noexcept {
-    const Real s = std::isfinite(strain) ? std::max(strain, Real(0)) : Real(bins) * bin;
-    const std::size_t k = std::min(bins - 1, static_cast<std::size_t>(s / bin));
-    ++m_counts[k];
+    ++m_counts[histogram_bin(strain)];
     ++m_samples;
+}
+
+void StrainHistogram::add(std::span<const Real> strains) noexcept {
+    for (const Real strain : strains) ++m_counts[histogram_bin(strain)];
+    m_samples += strains.size();
 }
 
 Real StrainHistogram::percentile(double q) const noexcept {
@@ -52,6 +65,37 @@ Vec3 body_up(const Garment& g, std::span<const EllipsoidFrame> frames) {
     return up.allFinite() ? up : Vec3::UnitY();
 }
 
+namespace {
+
+// A run of consecutive particles (the fabric's order keeps neighbours together) and the box
+// round them; `finite` false: a non-finite coordinate among them, no box.
+struct ParticleBlock {
+    Eigen::Index first = 0, end = 0;
+    Vec3 low, high;
+    bool finite = true;
+};
+
+std::vector<ParticleBlock> particle_blocks(const Matrix3X& x) {
+    constexpr Eigen::Index size = 64;
+    std::vector<ParticleBlock> blocks;
+    blocks.reserve(static_cast<std::size_t>((x.cols() + size - 1) / size));
+    for (Eigen::Index first = 0; first < x.cols(); first += size) {
+        ParticleBlock b;
+        b.first = first;
+        b.end = std::min(first + size, x.cols());
+        const auto part = x.middleCols(first, b.end - first);
+        b.finite = part.allFinite();
+        if (b.finite) {
+            b.low = part.rowwise().minCoeff();
+            b.high = part.rowwise().maxCoeff();
+        }
+        blocks.push_back(b);
+    }
+    return blocks;
+}
+
+}  // namespace
+
 GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame> frames, StrainHistogram* histogram,
                                Real ground_m) {
     GarmentQuality q;
@@ -75,7 +119,6 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
             if (std::isfinite(ratio)) q.compression_min = std::min(q.compression_min, ratio);
             const Real strain = std::isfinite(ratio) ? std::max(Real(0), ratio - 1) : std::numeric_limits<Real>::infinity();
             strains.push_back(strain);
-            if (histogram) histogram->add(strain);
             if (strain > worst) {
                 worst = strain;
                 q.worst_a = a;
@@ -83,11 +126,22 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
             }
         }
     q.springs = strains.size();
+    if (histogram) histogram->add(strains);
     if (!strains.empty()) {
+        // The p99 is the k-th of the strains in ascending order: the least of the largest
+        // n - k, kept in a min-heap as the strains pass (no NaN: a total order).
         const std::size_t k = std::min(strains.size() - 1, static_cast<std::size_t>(std::ceil(0.99 * double(strains.size()))) - 1);
-        std::nth_element(strains.begin(), strains.begin() + static_cast<std::ptrdiff_t>(k), strains.end());
-        q.strain_p99 = strains[k];
-        q.strain_max = *std::max_element(strains.begin(), strains.end());
+        const std::size_t top = strains.size() - k;
+        std::vector<Real> largest(strains.begin(), strains.begin() + static_cast<std::ptrdiff_t>(top));
+        std::make_heap(largest.begin(), largest.end(), std::greater<>());
+        for (std::size_t s = top; s < strains.size(); ++s)
+            if (strains[s] > largest.front()) {
+                std::pop_heap(largest.begin(), largest.end(), std::greater<>());
+                largest.back() = strains[s];
+                std::push_heap(largest.begin(), largest.end(), std::greater<>());
+            }
+        q.strain_p99 = largest.front();
+        q.strain_max = *std::max_element(largest.begin(), largest.end());
     }
 
     const Vec3 up = body_up(g, frames);
@@ -100,22 +154,27 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
     if (ground_m > -std::numeric_limits<Real>::infinity())
         for (Eigen::Index i = 0; i < x.cols(); ++i)
             if (w[i] != 0 && std::isfinite(x(1, i))) q.below_ground_m = std::max(q.below_ground_m, ground_m - x(1, i));
-    // Depths: each ellipsoid against the particles in its bounding box only; past its give
-    // where it gives (collision.hpp), the depth within the give kept apart.
+    // Depths: each ellipsoid against the particles in its bounding box only (blocks of
+    // neighbouring particles whose box misses it skipped whole); past its give where it
+    // gives (collision.hpp), the depth within the give kept apart.
+    const std::vector<ParticleBlock> blocks = particle_blocks(x);
     for (std::size_t e = 0; e < frames.size(); ++e) {
         const EllipsoidFrame& f = frames[e];
         if (!f.active) continue;
         const Vec3 half = f.rotation.cwiseAbs() * f.radii_m;
         const Vec3 low = f.center - half, high = f.center + half;
-        for (Eigen::Index i = 0; i < x.cols(); ++i) {
-            const Vec3 p = x.col(i);
-            if ((p.array() < low.array()).any() || (p.array() > high.array()).any()) continue;  // NaN too: counted above
-            const Real depth = penetration_depth(f, p);
-            if (depth <= 0) continue;
-            const Real past = f.give_m > 0 ? depth_past_give(frames, e, p) : depth;
-            Real& worst = w[i] == 0 ? q.pins_inside_m : q.penetration_m;
-            worst = std::max(worst, past);
-            if (w[i] != 0) q.within_give_m = std::max(q.within_give_m, depth - past);
+        for (const ParticleBlock& block : blocks) {
+            if (block.finite && ((block.high.array() < low.array()).any() || (block.low.array() > high.array()).any())) continue;
+            for (Eigen::Index i = block.first; i < block.end; ++i) {
+                const Vec3 p = x.col(i);
+                if ((p.array() < low.array()).any() || (p.array() > high.array()).any()) continue;  // NaN too: counted above
+                const Real depth = penetration_depth(f, p);
+                if (depth <= 0) continue;
+                const Real past = f.give_m > 0 ? depth_past_give(frames, e, p) : depth;
+                Real& worst = w[i] == 0 ? q.pins_inside_m : q.penetration_m;
+                worst = std::max(worst, past);
+                if (w[i] != 0) q.within_give_m = std::max(q.within_give_m, depth - past);
+            }
         }
     }
     return q;

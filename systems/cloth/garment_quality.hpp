@@ -84,6 +84,8 @@ public:
     static constexpr Real bin = Real(0.001);
     static constexpr std::size_t bins = 4000;  ///< Up to 400 %; beyond, the last bin.
     void add(Real strain) noexcept;
+    /// Every strain of `strains`, as add() one by one.
+    void add(std::span<const Real> strains) noexcept;
     /// Strain below which a share `q` of the samples lie (upper edge of the bin).
     [[nodiscard]] Real percentile(double q) const noexcept;
     [[nodiscard]] std::uint64_t samples() const noexcept { return m_samples; }

@@ -342,6 +342,52 @@ TEST(Pins, ThePinnedRowsOwnStrainIsMeasuredApart) {
     EXPECT_LT(after.pinned_strain_max, Real(0.6));
 }
 
+// The figures after a frame are what they say over every free spring and particle: the
+// p99 and the largest strain the order statistics of the free springs' strains, the deepest
+// free particle the deepest inside any active ellipsoid (measure_garment skips whole blocks
+// of particles and keeps only the largest strains as they pass). The skirt is shaken, some
+// particles pushed into the body, one moved to a non-finite place.
+TEST(GarmentQualityTest, FiguresAreTheOrderStatisticsOfEverySpringAndParticle) {
+    test::WalkingScene scene;
+    const Entity e = *attach_skirt(scene.registry, scene.body.character, TubeParams::skirt());
+    scene.run(1);
+    Garment& g = scene.registry.get<Garment>(e);
+    std::vector<EllipsoidFrame> frames;
+    update_frames(scene.registry, g.body, frames, 1);
+    std::uint32_t seed = 12345;
+    const auto noise = [&] {
+        seed = seed * 1664525u + 1013904223u;
+        return Real(seed >> 8) / Real(1 << 24) - Real(0.5);
+    };
+    for (Eigen::Index i = 0; i < g.state.x.cols(); ++i) {
+        if (g.state.inv_mass[i] == 0) continue;
+        g.state.x.col(i) += Real(0.01) * Vec3(noise(), noise(), noise());
+        if (i % 7 == 0) g.state.x.col(i) += Real(0.3) * (g.body.colliders.empty() ? Vec3::Zero() : Vec3(frames[0].center - g.state.x.col(i)));
+    }
+    for (const bool nonfinite : {false, true}) {
+        if (nonfinite) g.state.x(1, 5) = std::numeric_limits<Real>::quiet_NaN();
+        const GarmentQuality q = measure_garment(g, frames);
+        std::vector<Real> strains;
+        for (const SpringPhase* phase : {&g.fabric->warp1, &g.fabric->warp2, &g.fabric->weft})
+            for (std::size_t k = 0; k < phase->size(); ++k) {
+                if (g.state.inv_mass[phase->a[k]] == 0 && g.state.inv_mass[phase->b[k]] == 0) continue;
+                const Real ratio = (g.state.x.col(phase->b[k]) - g.state.x.col(phase->a[k])).norm() / phase->rest_m[k];
+                strains.push_back(std::isfinite(ratio) ? std::max(Real(0), ratio - 1) : std::numeric_limits<Real>::infinity());
+            }
+        std::sort(strains.begin(), strains.end());
+        const std::size_t k = static_cast<std::size_t>(std::ceil(0.99 * double(strains.size()))) - 1;
+        EXPECT_EQ(q.strain_p99, strains[k]);
+        EXPECT_EQ(q.strain_max, strains.back());
+        Real deepest = 0;
+        for (const EllipsoidFrame& f : frames)
+            for (Eigen::Index i = 0; i < g.state.x.cols(); ++i)
+                if (f.active && g.state.inv_mass[i] != 0 && g.state.x.col(i).allFinite())
+                    deepest = std::max(deepest, penetration_depth(f, g.state.x.col(i)));
+        EXPECT_GT(deepest, Real(0.01));
+        EXPECT_EQ(q.penetration_m, deepest);
+    }
+}
+
 // The worst spring is found and placed: its line and row, the ellipsoid nearest its middle,
 // and whether its chord passes through that ellipsoid (a piece thinner than the cloth's
 // spacing holding two neighbours apart) or only lies over it.
