@@ -713,6 +713,10 @@ DetectedPairs detect_brute_force(const Matrix3X& x, const VectorX& inv_mass, std
 
 namespace {
 
+// Colliders whose own move since their reference enters a particle's bound of its room
+// exactly (update_candidate_part step 3): the ones that moved most (a swinging foot, a hand).
+constexpr std::size_t fast_colliders = 4;
+
 // A collider in the anchor's frame (rigid, so distances hold), as a frame for the list tests.
 EllipsoidFrame in_anchor_frame(const EllipsoidFrame& f, const Affine3& anchor) {
     EllipsoidFrame a;
@@ -836,16 +840,40 @@ void update_candidate_part(const Garment& g, GarmentSolver& solver, std::size_t 
     //    column; where that is negative, the exact minimum (and the least clearance made
     //    exact again). A particle without slack becomes its own reference and is tested
     //    against every reference ellipsoid.
+    //    The colliders that moved most (at most fast_colliders) enter that bound exactly,
+    //    C_pe - D_e column by column, the others as min_e C_pe less the most any of them
+    //    moved: still a lower bound, so the same particles are spent, and fewer need the
+    //    exact minimum.
     const std::uint64_t active = active_mask(solver.frames);
-    Real most_moved = 0;
-    for_each_bit(active, [&](int e) { most_moved = std::max(most_moved, moved_since[static_cast<std::size_t>(e)]); });
+    std::array<int, fast_colliders> fast;
+    fast.fill(-1);
+    for_each_bit(active, [&](int e) {  // kept in order, the most moved first
+        for (int& slot : fast) {
+            if (slot < 0) {
+                slot = e;
+                break;
+            }
+            if (moved_since[static_cast<std::size_t>(e)] > moved_since[static_cast<std::size_t>(slot)]) std::swap(slot, e);
+        }
+    });
+    Real rest_moved = 0;
+    for_each_bit(active, [&](int e) {
+        if (std::find(fast.begin(), fast.end(), e) == fast.end())
+            rest_moved = std::max(rest_moved, moved_since[static_cast<std::size_t>(e)]);
+    });
     std::optional<ReferenceLanes> references;  // on first use
     alignas(64) std::array<Real, ReferenceLanes::max_lanes> stored;
     std::vector<Eigen::Index>& spent = part.spent;
     Real* least = lists.min_clearance_m.data();
+    VectorX& room = part.room;
     for (const auto [first, n] : runs) {
         const Eigen::Index count = n - first;
-        for (Eigen::Index p = first; p < n; ++p) slack[p] = least[p] - most_moved - slack[p];  // slack held d_p
+        room.resize(count);
+        room = lists.min_clearance_m.segment(first, count).array() - rest_moved;
+        for (const int e : fast)
+            if (e >= 0)
+                room = room.cwiseMin((clearance.col(e).segment(first, count).array() - moved_since[static_cast<std::size_t>(e)]).matrix());
+        slack.segment(first, count) = room - slack.segment(first, count);  // slack held d_p
         for (Eigen::Index p = first; p < n; ++p) {
             if (slack[p] >= 0) continue;
             Real room = std::numeric_limits<Real>::infinity(), exact = std::numeric_limits<Real>::infinity();

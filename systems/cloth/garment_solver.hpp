@@ -40,6 +40,7 @@ struct CandidateListPart {
     bool valid = false;                      ///< False: rebuild before the next test.
     std::vector<Affine3> reference_frames;   ///< Per collider: its reference, unit sphere -> anchor frame when its bit was last refreshed in this range (zero: none).
     std::vector<Eigen::Index> spent;         ///< Scratch: the particles whose list is refreshed.
+    VectorX room;                            ///< Scratch: a lower bound of each particle's room, per run.
     std::uint64_t frames_serial = 0;         ///< GarmentSolver::frames_serial when its lists were last brought up to date.
 };
 
