@@ -17,6 +17,7 @@
 #include "drape/components/animation_player.hpp"
 #include "drape/components/garment.hpp"
 #include "drape/game/world.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 
 namespace drape::bench {
 
@@ -24,24 +25,6 @@ namespace {
 
 constexpr int still_frames = 300;     // 5 s at 1/60 s
 constexpr double cut_share = 0.15;    // the simplified hem within this share of the classic one
-
-// Mean horizontal distance of the hem (each line's last particle) from the centre of the
-// fitting row (row 0). `grid_order`: columns are line * m + row (Fabric::rest_shape).
-double hem_radius_m(const Fabric& f, const Matrix3X& x, bool grid_order) {
-    const std::uint32_t m = f.particles_per_line;
-    const auto at = [&](std::uint32_t line, std::uint32_t row) -> Vec3 {
-        return x.col(grid_order ? line * m + row : f.grid[line * m + row]);
-    };
-    Vec3 centre = Vec3::Zero();
-    for (std::uint32_t line = 0; line < f.warp_lines; ++line) centre += at(line, 0);
-    centre /= static_cast<Real>(f.warp_lines);
-    double sum = 0;
-    for (std::uint32_t line = 0; line < f.warp_lines; ++line) {
-        const Vec3 p = at(line, m - 1);
-        sum += std::hypot(double(p.x() - centre.x()), double(p.z() - centre.z()));
-    }
-    return sum / f.warp_lines;
-}
 
 struct Row {
     std::string character, garment, model;

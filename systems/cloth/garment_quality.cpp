@@ -141,7 +141,7 @@ GarmentQuality measure_garment(const Garment& g, std::span<const EllipsoidFrame>
                 std::push_heap(largest.begin(), largest.end(), std::greater<>());
             }
         q.strain_p99 = largest.front();
-        q.strain_max = *std::max_element(largest.begin(), largest.end());
+        q.strain_max = worst;
     }
 
     const Vec3 up = body_up(g, frames);
@@ -221,6 +221,22 @@ GarmentQuality measure_garment(const Registry& registry, const Garment& garment,
     std::vector<EllipsoidFrame> frames;
     update_frames(registry, garment.body, frames, 1);
     return measure_garment(garment, frames, histogram, ground_height(registry));
+}
+
+double hem_radius_m(const Fabric& f, const Matrix3X& x, bool grid_order) {
+    const std::uint32_t m = f.particles_per_line;
+    const auto at = [&](std::uint32_t line, std::uint32_t row) -> Vec3 {
+        return x.col(grid_order ? line * m + row : f.grid[line * m + row]);
+    };
+    Vec3 centre = Vec3::Zero();
+    for (std::uint32_t line = 0; line < f.warp_lines; ++line) centre += at(line, 0);
+    centre /= static_cast<Real>(f.warp_lines);
+    double sum = 0;
+    for (std::uint32_t line = 0; line < f.warp_lines; ++line) {
+        const Vec3 p = at(line, m - 1);
+        sum += std::hypot(double(p.x() - centre.x()), double(p.z() - centre.z()));
+    }
+    return sum / f.warp_lines;
 }
 
 double kinetic_energy_J(const Matrix3X& v, const VectorX& inv_mass) {

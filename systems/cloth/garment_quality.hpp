@@ -95,6 +95,11 @@ private:
     std::uint64_t m_samples = 0;
 };
 
+/// Mean horizontal distance of the hem (each warp line's last particle) from the centre of
+/// the fitting row (row 0), m: how far a garment keeps its cut. `grid_order`: the columns of
+/// `x` are line * m + row (Fabric::rest_shape), else particles (GarmentState::x).
+[[nodiscard]] double hem_radius_m(const Fabric& fabric, const Matrix3X& x, bool grid_order);
+
 /// Kinetic energy of particles with masses 1 / inv_mass (pinned ones, inv_mass 0, left out), J.
 [[nodiscard]] double kinetic_energy_J(const Matrix3X& v, const VectorX& inv_mass);
 

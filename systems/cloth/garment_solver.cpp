@@ -36,20 +36,12 @@ SpringSet spring_set(const SpringPhase& phase, const VectorX& area, Real modulus
     return set;
 }
 
-// Bend springs along the weft rows: the weft springs (a beside b) chained, each particle
-// joined to the second beside it, at their distance in the cut (Fabric::rest_shape, grid
-// order), sorted as the fabric's phases are (strips, constraints.hpp).
-SpringPhase weft_bends(const Fabric& t) {
-    std::vector<std::uint32_t> grid_of(t.particle_count());
-    for (std::size_t i = 0; i < t.grid.size(); ++i) grid_of[t.grid[i]] = static_cast<std::uint32_t>(i);
-    std::vector<std::uint32_t> right(t.particle_count(), no_spring);
-    for (std::size_t k = 0; k < t.weft.size(); ++k) right[t.weft.a[k]] = t.weft.b[k];
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-    for (std::size_t k = 0; k < t.weft.size(); ++k)
-        if (const std::uint32_t c = right[t.weft.b[k]]; c != no_spring && c != t.weft.a[k]) pairs.emplace_back(t.weft.a[k], c);
-    std::sort(pairs.begin(), pairs.end());
+// The fabric's bend springs along its weft rows (each particle to the second beside it):
+// those whose ends lie on two lines (`line`: each particle's), in the fabric's order.
+SpringPhase weft_bends(const Fabric& t, const std::vector<std::uint32_t>& line) {
     SpringPhase phase;
-    for (const auto& [a, c] : pairs) phase.add(a, c, (t.rest_shape.col(grid_of[c]) - t.rest_shape.col(grid_of[a])).norm());
+    for (std::size_t k = 0; k < t.bend.size(); ++k)
+        if (line[t.bend.a[k]] != line[t.bend.b[k]]) phase.add(t.bend.a[k], t.bend.b[k], t.bend.rest_m[k]);
     return phase;
 }
 
@@ -79,12 +71,26 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
             }
         s.parts = make_parts(t, g.config.model, s.integrated);
         const GarmentParts& parts = s.parts;
+        s.below.resize(static_cast<std::size_t>(n));
+        s.above.resize(static_cast<std::size_t>(n));
+        s.grid_line.resize(static_cast<std::size_t>(n));
+        s.grid_row.resize(static_cast<std::size_t>(n));
+        s.repair_part.resize(static_cast<std::size_t>(n));
+        const std::uint32_t rows = t.particles_per_line;
+        for (std::uint32_t line = 0; line < t.warp_lines; ++line)
+            for (std::uint32_t row = 0; row < rows; ++row) {
+                s.grid_line[t.grid[line * rows + row]] = line;
+                s.grid_row[t.grid[line * rows + row]] = row;
+                s.repair_part[t.grid[line * rows + row]] = static_cast<std::uint32_t>(line % parts.count);
+                s.below[t.grid[line * rows + row]] = t.grid[line * rows + std::min(row + 1, rows - 1)];
+                s.above[t.grid[line * rows + row]] = t.grid[line * rows + (row > 0 ? row - 1 : 0)];
+            }
         s.springs.clear();
         s.weft_bend.reset();
         if (simplified && m.weft_bend != 0) {
             // Bending along the weft rows first, as the classic model's bend springs: the
             // structural springs and their limit have the last word (docs/cloth.md "Weft bending").
-            s.weft_bend = std::make_shared<const SpringPhase>(weft_bends(t));
+            s.weft_bend = std::make_shared<const SpringPhase>(weft_bends(t, s.grid_line));
             s.springs.push_back(spring_set(*s.weft_bend, area, m.bend_N_m, false, parts));
         }
         if (simplified) {
@@ -125,20 +131,6 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         if (lines)  // the warp limit's slack, so that a line can stretch as far as its springs may
             for (Real& l : tethers.length_m) l *= 1 + limit_share * m.strain_limit;
         s.tethers = split_tethers(tethers, parts.band, parts.count);
-        s.below.resize(static_cast<std::size_t>(n));
-        s.above.resize(static_cast<std::size_t>(n));
-        s.grid_line.resize(static_cast<std::size_t>(n));
-        s.grid_row.resize(static_cast<std::size_t>(n));
-        s.repair_part.resize(static_cast<std::size_t>(n));
-        const std::uint32_t rows = t.particles_per_line;
-        for (std::uint32_t line = 0; line < t.warp_lines; ++line)
-            for (std::uint32_t row = 0; row < rows; ++row) {
-                s.grid_line[t.grid[line * rows + row]] = line;
-                s.grid_row[t.grid[line * rows + row]] = row;
-                s.repair_part[t.grid[line * rows + row]] = static_cast<std::uint32_t>(line % parts.count);
-                s.below[t.grid[line * rows + row]] = t.grid[line * rows + std::min(row + 1, rows - 1)];
-                s.above[t.grid[line * rows + row]] = t.grid[line * rows + (row > 0 ? row - 1 : 0)];
-            }
         s.part_counters.assign(parts.count, PartCounters{});
         s.line_steps.assign(parts.count, 0);
         s.pushed.assign(parts.count, {});

@@ -5,35 +5,18 @@
 // the classic one's, which has bend springs (docs/reports/cut.md).
 #include <gtest/gtest.h>
 
-#include <cmath>
-
 #include "drape/components/animation_player.hpp"
 #include "drape/components/garment.hpp"
 #include "drape/game/contract.hpp"
 #include "drape/game/sample_scene.hpp"
 #include "drape/game/stats.hpp"
 #include "drape/game/world.hpp"
+#include "drape/systems/cloth/garment_quality.hpp"
 #include "drape/systems/cloth/garment_solver.hpp"
 #include "tests/figures.hpp"
 
 namespace drape {
 namespace {
-
-// Mean horizontal distance of the hem (each line's last particle) from the centre of the
-// fitting row.
-double hem_radius_m(const Garment& g) {
-    const Fabric& f = *g.fabric;
-    const std::uint32_t m = f.particles_per_line;
-    Vec3 centre = Vec3::Zero();
-    for (std::uint32_t line = 0; line < f.warp_lines; ++line) centre += g.state.x.col(f.grid[line * m]);
-    centre /= static_cast<Real>(f.warp_lines);
-    double sum = 0;
-    for (std::uint32_t line = 0; line < f.warp_lines; ++line) {
-        const Vec3 p = g.state.x.col(f.grid[line * m + m - 1]);
-        sum += std::hypot(double(p.x() - centre.x()), double(p.z() - centre.z()));
-    }
-    return sum / f.warp_lines;
-}
 
 // The sample scene's skirt on the avatar held in its first pose for `frames` frames.
 Result<World> still_skirt(ClothModel model, int weft_bend) {
@@ -99,7 +82,8 @@ TEST(WeftBend, KeepsTheStillSkirtsHemWithinFifteenPercentOfTheClassicModels) {
         EXPECT_EQ(stats.nonfinite, 0u);
         if (test::short_form()) continue;
         EXPECT_TRUE(contract_breaches(stats).empty()) << garment_verdict("skirt", stats);
-        hem[c] = hem_radius_m(world->registry.get<Garment>(world->garments.at(0)));
+        const Garment& g = world->registry.get<Garment>(world->garments.at(0));
+        hem[c] = hem_radius_m(*g.fabric, g.state.x, false);
     }
     if (test::short_form()) return;
     EXPECT_LT(hem[1], 0.85 * hem[0]) << "without weft bending the hem closes in";
