@@ -53,6 +53,8 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     if (o.start_s > 0) c += " --start " + parameter_number_text(o.start_s);
     if (o.warp_solve == WarpSolve::lines) c += " --warp-solve lines";
     if (o.thicken_thin_trunk_m > 0) c += " --thicken-thin-trunk " + parameter_number_text(o.thicken_thin_trunk_m);
+    if (o.pin_weights)
+        c += std::string(" --pin-weights ") + (*o.pin_weights == PinWeights::skin_surface ? "skin_surface" : "nearest_vertex");
     return c;
 }
 
@@ -109,6 +111,7 @@ void add_bench_command(CLI::App& app) {
         double start_s = 0;
         std::string warp_solve;
         double thicken_thin_trunk_m = 0;
+        std::string pin_weights;
     };
     auto cli = std::make_shared<Cli>();
     std::string names;
@@ -134,6 +137,10 @@ void add_bench_command(CLI::App& app) {
                         "M: the body fit thickens trunk pieces at most M thin inward to the thick ones (motions; default 0: "
                         "none; docs/cloth.md)")
         ->check(CLI::Range(0.0, 0.1));
+    command->add_option("--pin-weights", cli->pin_weights,
+                        "Skinned pins take the nearest skin vertex's weights or the skin's where they sit (motions; default: as "
+                        "shipped; docs/cloth.md)")
+        ->check(CLI::IsMember({"nearest_vertex", "skin_surface"}));
     command->add_flag("--overwrite", cli->overwrite, "Replace an existing --json file or a NAME.md this command did not write");
     command->footer("Benchmarks: " + names + ". Each writes NAME.md and NAME*.png in the output folder "
                     "and never asserts a timing; it fails only when it cannot run.");
@@ -167,7 +174,8 @@ void add_bench_command(CLI::App& app) {
         } limited[] = {{!garment_parameters.empty(), "--garment-param", {"motions", "cut"}},
                        {cli->start_s > 0, "--start", {"stability"}},
                        {!cli->warp_solve.empty(), "--warp-solve", {"motions", "stability"}},
-                       {cli->thicken_thin_trunk_m > 0, "--thicken-thin-trunk", {"motions"}}};
+                       {cli->thicken_thin_trunk_m > 0, "--thicken-thin-trunk", {"motions"}},
+                       {!cli->pin_weights.empty(), "--pin-weights", {"motions"}}};
         for (const auto& l : limited) {
             if (!l.given || std::find(l.takers.begin(), l.takers.end(), cli->name) != l.takers.end()) continue;
             std::string which = "the " + l.takers[0];
@@ -197,6 +205,8 @@ void add_bench_command(CLI::App& app) {
             options.start_s = cli->start_s;
             options.warp_solve = cli->warp_solve == "lines" ? WarpSolve::lines : WarpSolve::rounds;
             options.thicken_thin_trunk_m = cli->thicken_thin_trunk_m;
+            if (!cli->pin_weights.empty())
+                options.pin_weights = cli->pin_weights == "skin_surface" ? PinWeights::skin_surface : PinWeights::nearest_vertex;
             if (!cli->json.empty())
                 options.json = cli->name == "all" ? std::filesystem::path(cli->json) / (b->name + ".json")
                                                   : std::filesystem::path(cli->json);

@@ -116,6 +116,7 @@ struct RunOptions {
     std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.
     WarpSolve warp_solve = WarpSolve::rounds;                        ///< BenchOptions::warp_solve.
     double thicken_thin_trunk_m = 0;                                 ///< BenchOptions::thicken_thin_trunk_m.
+    std::optional<PinWeights> pin_weights;                           ///< BenchOptions::pin_weights.
     bool render = false;
     std::vector<int> grab_frames;     ///< Frames to render (with render).
 };
@@ -126,6 +127,7 @@ RunOptions run_options(const BenchOptions& options) {
     ro.garment_parameters = options.garment_parameters;
     ro.warp_solve = options.warp_solve;
     ro.thicken_thin_trunk_m = options.thicken_thin_trunk_m;
+    ro.pin_weights = options.pin_weights;
     return ro;
 }
 
@@ -137,6 +139,7 @@ SceneDescription case_scene(const MotionCase& c, const RunOptions& options) {
     spec.threads = options.threads;
     SceneDescription scene = scene_for(spec);
     for (const auto& [name, value] : options.garment_parameters) scene.garments.at(0).parameters.push_back({name, value});
+    if (options.pin_weights) scene.garments.at(0).pin_weights = *options.pin_weights;
     CharacterDescription& character = scene.characters.at(0);
     if (!c.character->default_avatar) {
         character = CharacterDescription{};
@@ -518,7 +521,12 @@ Result<void> run_motions(const BenchOptions& options) {
     nlohmann::json json = {{"frames", run_frames}, {"starts", starts}, {"threads", options.threads},
                            {"filter", options.filter}, {"garment_parameters", garment_parameters_json},
                            {"warp_solve", options.warp_solve == WarpSolve::lines ? "lines" : "rounds"},
-                           {"thicken_thin_trunk_m", options.thicken_thin_trunk_m}, {"runs", rows_json}};
+                           {"thicken_thin_trunk_m", options.thicken_thin_trunk_m},
+                           {"pin_weights", (options.pin_weights ? *options.pin_weights : GarmentDescription{}.pin_weights) ==
+                                                   PinWeights::skin_surface
+                                               ? "skin_surface"
+                                               : "nearest_vertex"},
+                           {"runs", rows_json}};
     return finish(report, options, json);
 }
 

@@ -13,6 +13,7 @@
 
 #include <unistd.h>
 
+#include "drape/game/scene_description.hpp"
 #include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape::bench {
@@ -52,6 +53,9 @@ std::string changed_parameters(const BenchOptions& options) {
     if (options.thicken_thin_trunk_m > 0)
         text += (text.empty() ? " but " : ", ") + std::string("trunk pieces at most ") + parameter_number_text(options.thicken_thin_trunk_m) +
                 " m thin thickened inward";
+    if (options.pin_weights && *options.pin_weights != GarmentDescription{}.pin_weights)
+        text += (text.empty() ? " but " : ", ") + std::string("pins weighted by the ") +
+                (*options.pin_weights == PinWeights::skin_surface ? "skin surface under them" : "nearest skin vertex");
     return text;
 }
 

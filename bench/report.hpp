@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +19,7 @@
 
 #include "drape/components/garment.hpp"
 #include "drape/engine/core/error.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape::bench {
 
@@ -41,6 +43,9 @@ struct BenchOptions {
     /// The characters' body fit: FitOptions::thicken_thin_trunk_m (`--thicken-thin-trunk`;
     /// motions only; 0: none, as shipped).
     double thicken_thin_trunk_m = 0;
+    /// How the garments' skinned pins are bound (`--pin-weights`; motions only; none: as
+    /// shipped, GarmentDescription::pin_weights).
+    std::optional<PinWeights> pin_weights;
 };
 
 /// The machine and conditions a report was measured under.

@@ -156,6 +156,7 @@ TEST_F(PlayCommand, BenchGarmentParametersAreCheckedByName) {
         {"bench motions --start 0.5", "drape bench: --start: only the stability benchmark takes it\n"},
         {"bench table1 --warp-solve lines", "drape bench: --warp-solve: only the motions and stability benchmarks take it\n"},
         {"bench quality --thicken-thin-trunk 0.015", "drape bench: --thicken-thin-trunk: only the motions benchmark takes it\n"},
+        {"bench cut --pin-weights skin_surface", "drape bench: --pin-weights: only the motions benchmark takes it\n"},
     };
     for (const Case& c : cases) {
         const PlayRun run = drape(c.args, m_dir);
