@@ -48,6 +48,11 @@ void add_inspect_command(CLI::App& app) {
                 std::printf("texture: none (drawn in the garment's colour)\n");
             else
                 std::printf("texture: base colour %dx%d, by the UVs, repeated\n", mesh->base_color.width, mesh->base_color.height);
+            if (mesh->uvs.cols() != mesh->positions.cols()) {
+                auto pattern = derive_pattern(*mesh, "pattern");
+                if (!pattern) { command_error("inspect", pattern.error().message); return; }
+                std::printf("pattern: %s\n", pattern->c_str());
+            }
             auto grid = grid_from_mesh(*mesh, {}, "grid");
             if (!grid) { command_error("inspect", grid.error().message); return; }
             std::printf("grid: %s\n", grid->how.c_str());

@@ -47,6 +47,16 @@ namespace {
 
 constexpr Real degrees = Real(3.14159265358979323846 / 180.0);
 
+// A mesh without UVs given its derived pattern (derive_pattern), with a line in `warnings`
+// saying so; a mesh with UVs is left as it is.
+Result<void> derived_pattern(GarmentMeshAsset& mesh, const std::string& field, const fs::path& file, std::vector<std::string>& warnings) {
+    if (mesh.uvs.cols() == mesh.positions.cols()) return {};
+    auto line = derive_pattern(mesh, field);
+    if (!line) return std::unexpected(line.error());
+    warnings.push_back(field + ": " + file.string() + ": " + *line);
+    return {};
+}
+
 // A garment from a file (docs/garments.md) on `body`: its mesh imported, gridded and held
 // as MeshGarmentParams says, the cloth from `params` (the scene's material, model, colour,
 // weft_stride and fitting_rows); the built-in garments' shape parameters do not apply. A
@@ -76,11 +86,13 @@ Result<Entity> attach_file_garment(Registry& registry, Entity body, const Garmen
             if (part.garment) modelled.push_back(part.mesh);
         auto mesh = garment_mesh_of_character(asset, g.mesh, modelled, field, &own);
         if (!mesh) return std::unexpected(mesh.error());
+        if (auto pattern = derived_pattern(*mesh, field, g.file, warnings); !pattern) return std::unexpected(pattern.error());
         mp.modelled_on = GarmentPose::bind;
         return attach_mesh_garment(registry, body, *mesh, mp, field);
     }
     auto mesh = import_garment_mesh(g.file, g.mesh);
     if (!mesh) return std::unexpected(mesh.error());
+    if (auto pattern = derived_pattern(*mesh, field, g.file, warnings); !pattern) return std::unexpected(pattern.error());
     if (g.pins == PinSource::file && mesh->pin.size() == 0)
         warnings.push_back(field + ": " + g.file.string() + " paints no pins (COLOR_0): held at its higher edge, " +
                            std::to_string(mp.fitting_rows) + (mp.fitting_rows == 1 ? " row" : " rows"));

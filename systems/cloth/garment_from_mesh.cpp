@@ -237,7 +237,7 @@ Result<MeshGrid> grid_from_mesh(const GarmentMeshAsset& mesh, const MeshGarmentP
     if (mesh.indices.empty() || mesh.indices.size() % 3 != 0) return fail(p + ": " + what + " has no triangles");
     if (mesh.uvs.cols() != mesh.positions.cols())
         return fail(p + ": " + what + " has no UV coordinates: the simplified model takes its warp and weft from the pattern "
-                                      "(a garment without UVs is not supported yet)");
+                                      "(derive_pattern gives it one from its shape)");
     const bool painted = params.pins == PinSource::painted || (params.pins == PinSource::file && mesh.pin.size() == mesh.positions.cols());
     if (painted && mesh.pin.size() != mesh.positions.cols())
         return fail(p + ".pins: " + what + " paints no pins (no COLOR_0): paint the held vertices red or use \"auto\"");
@@ -447,6 +447,94 @@ Result<MeshGrid> grid_from_mesh(const GarmentMeshAsset& mesh, const MeshGarmentP
     return out;
 }
 
+// A derived pattern (see the header): u the angle round the vertical axis through the
+// middle of the mesh's box, in metres at its median radius, from a seam in the widest
+// angular gap between its vertices (or, closed round, wherever the widest is); v the
+// height. A triangle spanning the seam takes copies of its vertices before it, a turn on.
+Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name) {
+    const std::string what = mesh.name.empty() ? "the mesh" : "mesh '" + mesh.name + "'";
+    const std::string p(name);
+    if (mesh.indices.empty() || mesh.indices.size() % 3 != 0) return fail(p + ": " + what + " has no triangles");
+    const auto count = static_cast<std::uint32_t>(mesh.vertex_count());
+    std::vector<std::uint8_t> used(count, 0);
+    for (const std::uint32_t v : mesh.indices) used[v] = 1;
+    Real lo_x = std::numeric_limits<Real>::infinity(), hi_x = -lo_x, lo_z = lo_x, hi_z = -lo_x;
+    for (std::uint32_t v = 0; v < count; ++v)
+        if (used[v]) {
+            lo_x = std::min(lo_x, mesh.positions(0, v)), hi_x = std::max(hi_x, mesh.positions(0, v));
+            lo_z = std::min(lo_z, mesh.positions(2, v)), hi_z = std::max(hi_z, mesh.positions(2, v));
+        }
+    const Real cx = (lo_x + hi_x) / 2, cz = (lo_z + hi_z) / 2;
+    constexpr double turn = 2 * std::numbers::pi;
+    std::vector<double> angle(count, 0);
+    std::vector<Real> radii, sorted;
+    for (std::uint32_t v = 0; v < count; ++v) {
+        if (!used[v]) continue;
+        const double dx = mesh.positions(0, v) - cx, dz = mesh.positions(2, v) - cz;
+        angle[v] = std::atan2(dx, dz);
+        radii.push_back(static_cast<Real>(std::hypot(dx, dz)));
+        sorted.push_back(static_cast<Real>(angle[v]));
+    }
+    std::sort(sorted.begin(), sorted.end());
+    double seam = sorted.back() + (sorted.front() + turn - sorted.back()) / 2, widest = sorted.front() + turn - sorted.back();
+    for (std::size_t k = 1; k < sorted.size(); ++k)
+        if (sorted[k] - sorted[k - 1] > widest) widest = sorted[k] - sorted[k - 1], seam = (sorted[k] + sorted[k - 1]) / 2.0;
+    std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+    const double radius = radii[radii.size() / 2];
+    if (!(radius > 0)) return fail(p + ": " + what + " has no UVs, and no pattern can be derived: it does not go round a vertical axis");
+    // Angles from the seam, in [0, 2 pi).
+    for (std::uint32_t v = 0; v < count; ++v)
+        if (used[v]) angle[v] = std::fmod(std::fmod(angle[v] - seam, turn) + turn, turn);
+    std::vector<std::uint32_t> copy(count, std::numeric_limits<std::uint32_t>::max());
+    std::vector<double> copy_angle;
+    std::vector<std::uint32_t> copy_of;
+    std::uint32_t next = count;
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        double lo = turn, hi = 0;
+        for (std::size_t k = 0; k < 3; ++k) lo = std::min(lo, angle[mesh.indices[t + k]]), hi = std::max(hi, angle[mesh.indices[t + k]]);
+        if (hi - lo <= std::numbers::pi) continue;
+        for (std::size_t k = 0; k < 3; ++k) {
+            const std::uint32_t v = mesh.indices[t + k];
+            if (v >= count || angle[v] >= std::numbers::pi) continue;
+            if (copy[v] == std::numeric_limits<std::uint32_t>::max()) copy[v] = next++, copy_angle.push_back(angle[v] + turn), copy_of.push_back(v);
+            mesh.indices[t + k] = copy[v];
+        }
+    }
+    const std::uint32_t total = next;
+    mesh.positions.conservativeResize(3, total);
+    if (mesh.pin.size() == count) mesh.pin.conservativeResize(total);
+    for (std::uint32_t v = 0; v < count; ++v)
+        if (copy[v] != std::numeric_limits<std::uint32_t>::max()) {
+            mesh.positions.col(copy[v]) = mesh.positions.col(v);
+            if (mesh.pin.size() == total) mesh.pin[copy[v]] = mesh.pin[v];
+        }
+    mesh.uvs.resize(2, total);
+    for (std::uint32_t v = 0; v < total; ++v) {
+        const double a = v < count ? angle[v] : copy_angle[v - count];
+        mesh.uvs.col(v) = Eigen::Matrix<Real, 2, 1>(static_cast<Real>(a * radius), mesh.positions(1, v < count ? v : copy_of[v - count]));
+    }
+    // Seen from its axis the mesh must not fold over itself: its triangles all turn one way.
+    std::size_t turned[2] = {0, 0};
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        using Vec2 = Eigen::Matrix<Real, 2, 1>;
+        const Vec2 a = mesh.uvs.col(mesh.indices[t]), b = mesh.uvs.col(mesh.indices[t + 1]), c = mesh.uvs.col(mesh.indices[t + 2]);
+        const Real area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+        if (area != 0) ++turned[area > 0 ? 1 : 0];
+    }
+    const std::size_t fewer = std::min(turned[0], turned[1]), triangles = mesh.indices.size() / 3;
+    if (fewer > triangles / 100)
+        return fail(p + ": " + what + " has no UVs, and no pattern can be derived: seen from its vertical axis " + std::to_string(fewer) +
+                    " of its " + std::to_string(triangles) + " triangles fold back over the others (give it UVs)");
+    std::ostringstream line;
+    line << what << " has no UVs: its pattern is derived round its vertical axis (u the angle at its median radius "
+         << number(std::round(radius * 1000) / 1000) << " m, v the height), ";
+    if (total == count)
+        line << "open where its widest gap round the axis is (" << number(std::round(widest * 180 / std::numbers::pi)) << " degrees)";
+    else
+        line << "cut at a seam, " << total - count << " vertices doubled";
+    return line.str();
+}
+
 Result<std::string> place_on_current_pose(const Registry& registry, Entity character, GarmentPose pose, GarmentMeshAsset& mesh,
                                           std::string_view name) {
     if (pose == GarmentPose::current) return std::string("modelled on the character as it stands");
@@ -589,6 +677,8 @@ Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const G
     if (const auto* c = registry.try_get<Character>(character))
         if (auto units = check_garment_units(authored, c->height_m, name); !units) return std::unexpected(units.error());
     GarmentMeshAsset mesh = authored;
+    if (mesh.uvs.cols() != mesh.positions.cols())
+        if (auto pattern = derive_pattern(mesh, name); !pattern) return std::unexpected(pattern.error());
     if (auto placed = place_on_current_pose(registry, character, params.modelled_on, mesh, name); !placed)
         return std::unexpected(placed.error());
     auto grid = grid_from_mesh(mesh, params, name);
@@ -635,18 +725,19 @@ Result<GarmentMeshAsset> garment_mesh_of_character(const CharacterAsset& asset, 
     out.name = label;
     std::size_t total = 0;
     for (const std::size_t k : chosen) {
-        if (!asset.meshes[k].has_uvs || mesh.uvs.cols() != mesh.bind_positions.cols())
-            return fail(std::string(name) + ": mesh '" + label + "' of " + file + " has no UV coordinates (a pattern is needed to grid it)");
         total += asset.meshes[k].vertex_count;
     }
     out.positions.resize(3, static_cast<Eigen::Index>(total));
-    out.uvs.resize(2, static_cast<Eigen::Index>(total));
+    // A part without UVs leaves the whole mesh without (a pattern is derived for it).
+    const bool uvs = mesh.uvs.cols() == mesh.bind_positions.cols() &&
+                     std::all_of(chosen.begin(), chosen.end(), [&](std::size_t k) { return asset.meshes[k].has_uvs; });
+    if (uvs) out.uvs.resize(2, static_cast<Eigen::Index>(total));
     Eigen::Index at = 0;
     for (const std::size_t k : chosen) {
         const MeshInfo& info = asset.meshes[k];
         const Eigen::Index first = info.first_vertex, count = info.vertex_count;
         out.positions.middleCols(at, count) = mesh.bind_positions.middleCols(first, count);
-        out.uvs.middleCols(at, count) = mesh.uvs.middleCols(first, count);
+        if (uvs) out.uvs.middleCols(at, count) = mesh.uvs.middleCols(first, count);
         if (k < mesh.submeshes.size()) {
             const Submesh& sub = mesh.submeshes[k];
             for (std::uint32_t i = sub.first_index; i < sub.first_index + sub.index_count; ++i)

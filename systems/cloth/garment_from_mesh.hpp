@@ -25,9 +25,14 @@
 // legs or a cape beside an arm is carried by the hips and the spine, and the cloth then
 // finds the limbs where they are.
 //
+// A mesh without UVs gets a pattern derived from its shape (derive_pattern): u round the
+// body's vertical axis, v the height, as a tube or a sheet wrapped round the body is cut;
+// one that folds back over itself seen from that axis is refused.
+//
 // Not yet: panels that a level of v crosses twice (straps, slits, holes), panels sewn
-// other than side by side (a yoke, a gusset), and meshes without UVs (which would need the
-// classic model on their own edges); each is refused with one line that says so.
+// other than side by side (a yoke, a gusset), and meshes without UVs that cannot be
+// derived so (which would need the classic model on their own edges); each is refused with
+// one line that says so.
 #pragma once
 
 #include <cstdint>
@@ -76,6 +81,15 @@ struct MeshGrid {
     std::string how;
 };
 
+/// Gives `mesh`, which has no UVs, a pattern: u the angle round the vertical (y) axis
+/// through the middle of its box, in metres at the vertices' median distance from it,
+/// starting at a seam in the widest angular gap between its vertices (a mesh closed round
+/// is cut there: the triangles across it take copies of their vertices, one turn on); v
+/// the height. Returns one line saying so; fails, prefixed with `name`, where seen from
+/// that axis more than 1 % of its triangles fold back over the others (a sleeve, a
+/// collar turned down), or it has no triangles.
+[[nodiscard]] Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name);
+
 /// Turns `mesh` into a grid; errors are prefixed with `name`.
 [[nodiscard]] Result<MeshGrid> grid_from_mesh(const GarmentMeshAsset& mesh, const MeshGarmentParams& params, std::string_view name);
 
@@ -122,7 +136,8 @@ inline constexpr Real garment_far_fraction = Real(0.1);
                                                    std::string_view mesh_name, std::string_view name);
 
 /// `mesh` (in `character`'s model space, modelled on the pose params.modelled_on says) as
-/// cloth on `character` (attach_grid_garment); a mesh in other units than the character
+/// cloth on `character` (attach_grid_garment; without UVs, on the pattern derive_pattern
+/// gives it); a mesh in other units than the character
 /// (check_garment_units, against Character::height_m), inside the body, not round it or
 /// far from it (check_garment_placement) is refused.
 [[nodiscard]] Result<Entity> attach_mesh_garment(Registry& registry, Entity character, const GarmentMeshAsset& mesh,

@@ -465,6 +465,86 @@ TEST_F(GarmentFile, AMeshResampledAtAFinerSpacingLiesOnItsSurfaceAndWalks) {
     EXPECT_TRUE(contract_breaches(stats).empty()) << garment_verdict("skirt", stats);
 }
 
+// A mesh without UVs (an OBJ straight from a sculpt): its pattern is derived round the
+// vertical axis, the tube cut at a seam, and it is gridded like the file with UVs, its grid
+// points on its surface; put on, it says so in one line and walks within the contract. Seen
+// from its axis, a mesh folding back over itself (a hem turned up inside) is refused.
+// Labelled `figures`: the short form walks 36 frames and asserts that they run clean.
+TEST_F(GarmentFile, AMeshWithoutUVsIsGriddedRoundItsAxisAndWalks) {
+    GarmentMeshAsset mesh = exported(GarmentType::skirt);
+    ASSERT_GT(mesh.vertex_count(), 0u);
+    mesh.uvs.resize(2, 0);
+    mesh.pin.resize(0);
+    // Welded as a modeller keeps a tube: the pattern's seam (its first line written twice) closed.
+    for (std::uint32_t& i : mesh.indices)
+        for (std::uint32_t j = 0; j < i; ++j)
+            if (mesh.positions.col(j) == mesh.positions.col(i)) {
+                i = j;
+                break;
+            }
+    GarmentMeshAsset derived = mesh;
+    auto line = derive_pattern(derived, "garment");
+    ASSERT_TRUE(line) << line.error().message;
+    EXPECT_NE(line->find("cut at a seam"), std::string::npos) << *line;
+    EXPECT_GT(derived.vertex_count(), mesh.vertex_count());  // the seam's vertices, doubled
+    EXPECT_EQ(derived.uvs.cols(), derived.positions.cols());
+    auto grid = grid_from_mesh(derived, {}, "garment");
+    ASSERT_TRUE(grid) << grid.error().message;
+    EXPECT_TRUE(grid->grid.closed) << grid->how;
+    EXPECT_NE(grid->how.find("1 panel sewn at 1 seam, closed"), std::string::npos) << grid->how;
+    // The built-in skirt's 0.029 m lines and rows: as many, give or take a stride of lines.
+    MeshGarmentParams resampled;
+    resampled.spacing_m = Real(0.029);
+    auto with_uvs = grid_from_mesh(exported(GarmentType::skirt), resampled, "garment");
+    ASSERT_TRUE(with_uvs) << with_uvs.error().message;
+    EXPECT_NEAR(grid->grid.warp_lines, with_uvs->grid.warp_lines, 3);
+    EXPECT_NEAR(grid->grid.particles_per_line, with_uvs->grid.particles_per_line, 2);
+    // Every grid point within 0.1 mm of the mesh's surface.
+    const auto distance = [&](const Vec3& p) {
+        Real best = std::numeric_limits<Real>::infinity();
+        for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+            const Vec3 a = mesh.positions.col(mesh.indices[t]), b = mesh.positions.col(mesh.indices[t + 1]),
+                       c = mesh.positions.col(mesh.indices[t + 2]);
+            const Vec3 n = (b - a).cross(c - a).normalized();
+            const Vec3 q = p - n * n.dot(p - a);
+            const Real area = (b - a).cross(c - a).norm();
+            const Real sum = (b - q).cross(c - q).norm() + (c - q).cross(a - q).norm() + (a - q).cross(b - q).norm();
+            if (sum <= area * Real(1.001)) best = std::min(best, std::abs(n.dot(p - a)));
+        }
+        return best;
+    };
+    Real farthest = 0;
+    for (Eigen::Index k = 0; k < grid->grid.grid_positions.cols(); ++k) farthest = std::max(farthest, distance(grid->grid.grid_positions.col(k)));
+    EXPECT_LT(farthest, Real(1e-4));
+
+    GarmentMeshAsset folded = mesh;  // the lower half turned up inside the upper
+    const Real mid = (folded.positions.row(1).minCoeff() + folded.positions.row(1).maxCoeff()) / 2;
+    for (Eigen::Index v = 0; v < folded.positions.cols(); ++v)
+        if (folded.positions(1, v) < mid) folded.positions(1, v) = 2 * mid - folded.positions(1, v), folded.positions.col(v).x() *= Real(0.98);
+    auto refused = derive_pattern(folded, "garments[0]");
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("garments[0]: mesh 'Garment' has no UVs, and no pattern can be derived: seen from its vertical "
+                                           "axis"),
+              std::string::npos)
+        << refused.error().message;
+
+    const fs::path file = dir / "no_uvs.glb";
+    ASSERT_TRUE(write_garment_mesh(file, mesh));
+    SceneDescription scene = sample_scene();
+    scene.garments = {from_file(file)};
+    auto world = build_world(scene, {});
+    ASSERT_TRUE(world) << world.error().message;
+    bool said = false;
+    for (const std::string& w : world->warnings)
+        said = said || w == "garments[0]: " + file.string() + ": " + *line;
+    EXPECT_TRUE(said) << (world->warnings.empty() ? "no warnings" : world->warnings.back());
+    for (int frame = 0; frame < test::frames(180); ++frame) ASSERT_TRUE(step_world(*world, 1.0 / 60.0));
+    const GarmentStats stats = run_stats(*world).garments.at(0);
+    EXPECT_EQ(stats.nonfinite, 0u);
+    if (test::short_form()) return;
+    EXPECT_TRUE(contract_breaches(stats).empty()) << garment_verdict("skirt", stats);
+}
+
 TEST_F(GarmentFile, BadFilesAndFieldsGetOneLineNamingThem) {
     const auto message = [](const auto& result) { return result ? std::string("(no error)") : result.error().message; };
     EXPECT_EQ(message(import_garment_mesh(dir / "missing.glb")), (dir / "missing.glb").string() + ": no such file");
