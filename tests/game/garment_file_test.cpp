@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 
 #include <unistd.h>
@@ -516,6 +517,28 @@ TEST_F(GarmentFile, AMeshWithoutUVsIsGriddedRoundItsAxisAndWalks) {
     Real farthest = 0;
     for (Eigen::Index k = 0; k < grid->grid.grid_positions.cols(); ++k) farthest = std::max(farthest, distance(grid->grid.grid_positions.col(k)));
     EXPECT_LT(farthest, Real(1e-4));
+
+    // Open at the back (its triangles within 30 degrees of -z taken out, a wrap skirt's
+    // opening): no seam is cut, the pattern opens there and the grid is open.
+    GarmentMeshAsset open = mesh;
+    const Vec3 centre = mesh.positions.rowwise().mean();
+    std::vector<std::uint32_t> kept;
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        bool back = false;
+        for (std::size_t k = 0; k < 3; ++k) {
+            const Vec3 d = mesh.positions.col(mesh.indices[t + k]) - centre;
+            back = back || std::abs(std::atan2(d.x(), -d.z())) * 180 / std::numbers::pi_v<Real> < 15;
+        }
+        if (!back) kept.insert(kept.end(), mesh.indices.begin() + static_cast<std::ptrdiff_t>(t), mesh.indices.begin() + static_cast<std::ptrdiff_t>(t) + 3);
+    }
+    open.indices = kept;
+    auto open_line = derive_pattern(open, "garment");
+    ASSERT_TRUE(open_line) << open_line.error().message;
+    EXPECT_NE(open_line->find("open where its widest gap round the axis is"), std::string::npos) << *open_line;
+    EXPECT_EQ(open.vertex_count(), mesh.vertex_count());
+    auto open_grid = grid_from_mesh(open, {}, "garment");
+    ASSERT_TRUE(open_grid) << open_grid.error().message;
+    EXPECT_FALSE(open_grid->grid.closed) << open_grid->how;
 
     GarmentMeshAsset folded = mesh;  // the lower half turned up inside the upper
     const Real mid = (folded.positions.row(1).minCoeff() + folded.positions.row(1).maxCoeff()) / 2;
