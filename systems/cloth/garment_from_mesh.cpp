@@ -457,7 +457,10 @@ Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name
     if (mesh.indices.empty() || mesh.indices.size() % 3 != 0) return fail(p + ": " + what + " has no triangles");
     const auto count = static_cast<std::uint32_t>(mesh.vertex_count());
     std::vector<std::uint8_t> used(count, 0);
-    for (const std::uint32_t v : mesh.indices) used[v] = 1;
+    for (const std::uint32_t v : mesh.indices) {
+        if (v >= count) return fail(p + ": " + what + " has a triangle on vertex " + std::to_string(v) + " of " + std::to_string(count));
+        used[v] = 1;
+    }
     Real lo_x = std::numeric_limits<Real>::infinity(), hi_x = -lo_x, lo_z = lo_x, hi_z = -lo_x;
     for (std::uint32_t v = 0; v < count; ++v)
         if (used[v]) {
@@ -495,7 +498,7 @@ Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name
         if (hi - lo <= std::numbers::pi) continue;
         for (std::size_t k = 0; k < 3; ++k) {
             const std::uint32_t v = mesh.indices[t + k];
-            if (v >= count || angle[v] >= std::numbers::pi) continue;
+            if (angle[v] >= std::numbers::pi) continue;
             if (copy[v] == std::numeric_limits<std::uint32_t>::max()) copy[v] = next++, copy_angle.push_back(angle[v] + turn), copy_of.push_back(v);
             mesh.indices[t + k] = copy[v];
         }

@@ -544,6 +544,11 @@ TEST_F(GarmentFile, AMeshWithoutUVsIsGriddedRoundItsAxisAndWalks) {
     const Real mid = (folded.positions.row(1).minCoeff() + folded.positions.row(1).maxCoeff()) / 2;
     for (Eigen::Index v = 0; v < folded.positions.cols(); ++v)
         if (folded.positions(1, v) < mid) folded.positions(1, v) = 2 * mid - folded.positions(1, v), folded.positions.col(v).x() *= Real(0.98);
+    GarmentMeshAsset past = mesh;  // a triangle on a vertex the mesh does not have
+    past.indices[0] = static_cast<std::uint32_t>(past.vertex_count()) + 7;
+    auto bad = derive_pattern(past, "garments[0]");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("garments[0]: mesh 'Garment' has a triangle on vertex"), std::string::npos) << bad.error().message;
     auto refused = derive_pattern(folded, "garments[0]");
     ASSERT_FALSE(refused);
     EXPECT_NE(refused.error().message.find("garments[0]: mesh 'Garment' has no UVs, and no pattern can be derived: seen from its vertical "
