@@ -53,8 +53,7 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     if (o.start_s > 0) c += " --start " + parameter_number_text(o.start_s);
     if (o.warp_solve == WarpSolve::lines) c += " --warp-solve lines";
     if (o.thicken_thin_trunk_m > 0) c += " --thicken-thin-trunk " + parameter_number_text(o.thicken_thin_trunk_m);
-    if (o.pin_weights)
-        c += std::string(" --pin-weights ") + (*o.pin_weights == PinWeights::skin_surface ? "skin_surface" : "nearest_vertex");
+    if (o.pin_weights) c += std::string(" --pin-weights ") + bench::pin_weights_name(*o.pin_weights);
     return c;
 }
 

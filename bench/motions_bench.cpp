@@ -522,10 +522,7 @@ Result<void> run_motions(const BenchOptions& options) {
                            {"filter", options.filter}, {"garment_parameters", garment_parameters_json},
                            {"warp_solve", options.warp_solve == WarpSolve::lines ? "lines" : "rounds"},
                            {"thicken_thin_trunk_m", options.thicken_thin_trunk_m},
-                           {"pin_weights", (options.pin_weights ? *options.pin_weights : GarmentDescription{}.pin_weights) ==
-                                                   PinWeights::skin_surface
-                                               ? "skin_surface"
-                                               : "nearest_vertex"},
+                           {"pin_weights", pin_weights_name(options.pin_weights.value_or(GarmentDescription{}.pin_weights))},
                            {"runs", rows_json}};
     return finish(report, options, json);
 }

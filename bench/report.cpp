@@ -45,6 +45,10 @@ bool have_program(const std::string& program) {
 
 }  // namespace
 
+const char* pin_weights_name(PinWeights weights) {
+    return weights == PinWeights::skin_surface ? "skin_surface" : "nearest_vertex";
+}
+
 std::string changed_parameters(const BenchOptions& options) {
     std::string text;
     for (const auto& [name, value] : options.garment_parameters)

@@ -60,6 +60,9 @@ struct Machine {
 };
 
 [[nodiscard]] Machine describe_machine();
+/// The name a scene and `--pin-weights` give `weights` ("nearest_vertex", "skin_surface").
+[[nodiscard]] const char* pin_weights_name(PinWeights weights);
+
 /// ", but NAME = VALUE, ..." for the settings `options` changes from the shipped ones
 /// (garment parameters, the warp solve, the body fit's thickening); empty when none.
 [[nodiscard]] std::string changed_parameters(const BenchOptions& options);

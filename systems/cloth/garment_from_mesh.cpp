@@ -489,8 +489,7 @@ Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name
     for (std::uint32_t v = 0; v < count; ++v)
         if (used[v]) angle[v] = std::fmod(std::fmod(angle[v] - seam, turn) + turn, turn);
     std::vector<std::uint32_t> copy(count, std::numeric_limits<std::uint32_t>::max());
-    std::vector<double> copy_angle;
-    std::vector<std::uint32_t> copy_of;
+    std::vector<std::uint32_t> copy_of;  // per copy: the vertex it copies
     std::uint32_t next = count;
     for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
         double lo = turn, hi = 0;
@@ -499,7 +498,7 @@ Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name
         for (std::size_t k = 0; k < 3; ++k) {
             const std::uint32_t v = mesh.indices[t + k];
             if (angle[v] >= std::numbers::pi) continue;
-            if (copy[v] == std::numeric_limits<std::uint32_t>::max()) copy[v] = next++, copy_angle.push_back(angle[v] + turn), copy_of.push_back(v);
+            if (copy[v] == std::numeric_limits<std::uint32_t>::max()) copy[v] = next++, copy_of.push_back(v);
             mesh.indices[t + k] = copy[v];
         }
     }
@@ -513,8 +512,9 @@ Result<std::string> derive_pattern(GarmentMeshAsset& mesh, std::string_view name
         }
     mesh.uvs.resize(2, total);
     for (std::uint32_t v = 0; v < total; ++v) {
-        const double a = v < count ? angle[v] : copy_angle[v - count];
-        mesh.uvs.col(v) = Eigen::Matrix<Real, 2, 1>(static_cast<Real>(a * radius), mesh.positions(1, v < count ? v : copy_of[v - count]));
+        const std::uint32_t from = v < count ? v : copy_of[v - count];
+        const double a = v < count ? angle[v] : angle[from] + turn;  // a copy: one turn on
+        mesh.uvs.col(v) = Eigen::Matrix<Real, 2, 1>(static_cast<Real>(a * radius), mesh.positions(1, from));
     }
     // Seen from its axis the mesh must not fold over itself: its triangles all turn one way.
     std::size_t turned[2] = {0, 0};
