@@ -165,6 +165,11 @@ struct GarmentConfig {
     /// up to that pin of where it hangs in the rest shape, carried by the anchor (the max
     /// distance of Unity Cloth, NvCloth's motion constraints; docs/cloth.md). 0: none.
     Real max_distance_share = 0;
+    /// With a max distance: true, each sphere's centre is the particle's rest place skinned by
+    /// the skin of the trunk and legs nearest it (GarmentBody::rest_on_skin: a raised thigh
+    /// carries it, as Unity Cloth's and Jolt's skinned constraints); false, the anchor carries
+    /// the rest shape.
+    bool max_distance_on_skin = false;
     Vec3 color = Vec3(0.75f, 0.12f, 0.18f);  ///< Linear RGB.
     friend bool operator==(const GarmentConfig&, const GarmentConfig&) = default;
 };
@@ -193,6 +198,9 @@ struct GarmentBody {
     std::vector<Entity> colliders;           ///< EllipsoidCollider entities the garment collides with (<= 64).
     std::int32_t anchor = -1;                ///< Collider whose rigid motion is "the body" of method §3.3 (-1: none).
     Matrix3X rest_local;                     ///< Rest shape in the anchor's frame (rotation + centre), for resets.
+    /// GarmentConfig::max_distance_on_skin: one per particle, its rest place bound to the skin of
+    /// the trunk and legs as a skinned pin is (PinKind::skinned); empty otherwise.
+    std::vector<PinBinding> rest_on_skin;
 };
 
 /// Particle state in structure-of-arrays form.

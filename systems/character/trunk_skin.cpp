@@ -8,13 +8,16 @@
 namespace drape {
 
 std::optional<TrunkSkin> trunk_skin(const MeshAsset& body, const SkeletonAsset& skeleton, const BodyLandmarks* landmarks,
-                                    std::span<const Affine3> skinning) {
+                                    std::span<const Affine3> skinning, bool with_legs) {
     const std::size_t bones = skeleton.size();
     if (body.vertex_count() == 0 || body.indices.empty() || (!skinning.empty() && skinning.size() != bones)) return std::nullopt;
     std::vector<char> trunk(bones, 1);
     if (landmarks)
-        for (const LimbChain* limb : {&landmarks->left_leg, &landmarks->right_leg, &landmarks->left_arm, &landmarks->right_arm})
-            if (limb->root >= 0 && static_cast<std::size_t>(limb->root) < bones) trunk[static_cast<std::size_t>(limb->root)] = 0;
+        for (const LimbChain* limb : {&landmarks->left_leg, &landmarks->right_leg, &landmarks->left_arm, &landmarks->right_arm}) {
+            const bool leg = limb == &landmarks->left_leg || limb == &landmarks->right_leg;
+            if (!(with_legs && leg) && limb->root >= 0 && static_cast<std::size_t>(limb->root) < bones)
+                trunk[static_cast<std::size_t>(limb->root)] = 0;
+        }
     for (std::size_t b = 0; b < bones; ++b)  // parents precede children
         if (skeleton.parents[b] >= 0 && !trunk[static_cast<std::size_t>(skeleton.parents[b])]) trunk[b] = 0;
     const auto trunk_share = [&](std::uint32_t v) {

@@ -38,9 +38,12 @@ struct TrunkSkin {
 };
 
 /// The trunk's skin of `body` at the pose `skinning` gives (Skeleton::skinning; empty: the
-/// bind pose); nothing when no face hangs from the trunk or the sizes disagree.
+/// bind pose); nothing when no face hangs from the trunk or the sizes disagree. `with_legs`:
+/// the legs count as trunk too (the skin a hanging garment's free cloth follows: the max
+/// distance's spheres on the skin, docs/cloth.md), only the arms left out.
 [[nodiscard]] std::optional<TrunkSkin> trunk_skin(const MeshAsset& body, const SkeletonAsset& skeleton,
-                                                  const BodyLandmarks* landmarks, std::span<const Affine3> skinning);
+                                                  const BodyLandmarks* landmarks, std::span<const Affine3> skinning,
+                                                  bool with_legs = false);
 
 /// The trunk's influences at the closest point of its skin to `point` (model space, the
 /// skin's pose): strongest first, summing to 1; empty when none.

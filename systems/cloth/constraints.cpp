@@ -452,16 +452,18 @@ void solve_tethers(const Tethers& t, Matrix3XRows& x) {
     }
 }
 
-void solve_max_distance(const Tethers& t, const Matrix3X& rest_local, const Affine3& anchor, Real share, Matrix3XRows& x) {
-    if (!(share > 0) || rest_local.cols() == 0) return;  // a rest shape is one column per particle
+namespace {
+
+// Each tethered particle outside its sphere, centred at `centre(p)`, of share x its tether's
+// length goes onto it.
+template <class Centre>
+void keep_within_spheres(const Tethers& t, Real share, Matrix3XRows& x, Centre&& centre) {
     Real* x0 = x.row(0).data();
     Real* x1 = x.row(1).data();
     Real* x2 = x.row(2).data();
-    const Mat3 r = anchor.linear();
-    const Vec3 c = anchor.translation();
     for (std::size_t k = 0; k < t.particle.size(); ++k) {
         const std::uint32_t p = t.particle[k];
-        const Vec3 target = r * rest_local.col(p) + c;
+        const Vec3 target = centre(p);
         const Real d0 = x0[p] - target[0], d1 = x1[p] - target[1], d2 = x2[p] - target[2];
         const Real radius = share * t.length_m[k];
         const Real distance_sq = d0 * d0 + d1 * d1 + d2 * d2;
@@ -471,6 +473,27 @@ void solve_max_distance(const Tethers& t, const Matrix3X& rest_local, const Affi
         x1[p] = target[1] + d1 * scale;
         x2[p] = target[2] + d2 * scale;
     }
+}
+
+}  // namespace
+
+void solve_max_distance(const Tethers& t, const Matrix3X& rest_local, const Affine3& anchor, Real share, Matrix3XRows& x) {
+    if (!(share > 0) || rest_local.cols() == 0) return;  // a rest shape is one column per particle
+    const Mat3 r = anchor.linear();
+    const Vec3 c = anchor.translation();
+    keep_within_spheres(t, share, x, [&](std::uint32_t p) { return Vec3(r * rest_local.col(p) + c); });
+}
+
+void solve_max_distance(const Tethers& t, const Matrix3X& previous, const Matrix3X& target, Real alpha, const Matrix3X& rest_local,
+                        const Affine3& anchor, Real share, Matrix3XRows& x) {
+    if (!(share > 0) || target.cols() != x.cols() || previous.cols() != x.cols() || rest_local.cols() != x.cols()) return;
+    const Mat3 r = anchor.linear();
+    const Vec3 c = anchor.translation();
+    keep_within_spheres(t, share, x, [&](std::uint32_t p) {
+        Vec3 centre = (1 - alpha) * previous.col(p) + alpha * target.col(p);
+        centre[1] = std::min(centre[1], (r * rest_local.col(p) + c)[1]);  // never above the anchor's
+        return centre;
+    });
 }
 
 std::uint64_t limit_warp_lines(const Fabric& f, const VectorX& rest_above, const VectorX& w, Real stretch, Matrix3X& x,

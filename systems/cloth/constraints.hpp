@@ -146,6 +146,14 @@ void solve_tethers(const Tethers& tethers, Matrix3XRows& x);
 void solve_max_distance(const Tethers& tethers, const Matrix3X& rest_local, const Affine3& anchor, Real share,
                         Matrix3XRows& x);
 
+/// The same with each sphere's centre given per particle (GarmentConfig::max_distance_on_skin):
+/// `(1 - alpha) previous.col(p) + alpha target.col(p)`, the centres at the start and the end of
+/// the fixed step and the substep's share of it, lowered to the anchor's centre
+/// `anchor * rest_local.col(p)` where higher (world y): a leg carries its spheres forward
+/// and back, not up.
+void solve_max_distance(const Tethers& tethers, const Matrix3X& previous, const Matrix3X& target, Real alpha,
+                        const Matrix3X& rest_local, const Affine3& anchor, Real share, Matrix3XRows& x);
+
 /// After the rounds: the warp limit (Provot's rule for a fixed end, method §4.1). Row after
 /// row from the fitting zone down, a free particle farther than (1 + stretch) x rest from
 /// the particle above it on its line is moved back onto that sphere, the particle above

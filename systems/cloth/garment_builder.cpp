@@ -106,6 +106,7 @@ GarmentConfig garment_config(const TubeParams& p) {
     c.material = p.material;
     c.inertia = InertiaScales{p.inertia_linear, p.inertia_angular, p.inertia_max_linear_m_s2, p.inertia_max_fall_m_s2};
     c.max_distance_share = p.max_distance_share;
+    c.max_distance_on_skin = p.max_distance_on_skin != 0;
     c.color = p.color;
     return c;
 }
@@ -268,6 +269,44 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
     return pin;
 }
 
+// GarmentConfig::max_distance_on_skin: each free particle's rest place bound to the skin of
+// the trunk and legs (the arms left out: a hand hanging at the hip does not carry a skirt) at
+// its closest point there, by that point's weights, as a skin_surface pin is. Nothing (the
+// anchor carries the spheres) without a skinned body or where a binding cannot be inverted.
+void bind_rest_to_skin(const Registry& registry, Garment& g) {
+    g.body.rest_on_skin.clear();
+    if (!g.config.max_distance_on_skin) return;
+    const auto* skin = registry.try_get<SkinnedMesh>(g.body.character);
+    const auto* skeleton = registry.try_get<Skeleton>(g.body.character);
+    if (!skin || !skin->mesh || !skeleton || !skeleton->asset || skeleton->skinning.size() != skeleton->asset->size()) return;
+    const std::optional<TrunkSkin> body = trunk_skin(*skin->mesh, *skeleton->asset, registry.try_get<BodyLandmarks>(g.body.character),
+                                                     skeleton->skinning, /*with_legs=*/true);
+    if (!body) return;
+    const auto* transform = registry.try_get<Transform>(g.body.character);
+    const Affine3 to_model = transform ? transform->matrix().inverse() : Affine3::Identity();
+    const Eigen::Index n = g.state.x.cols();
+    std::vector<PinBinding> bound(static_cast<std::size_t>(n));
+    for (Eigen::Index p = 0; p < n; ++p) {
+        PinBinding& b = bound[static_cast<std::size_t>(p)];
+        b.particle = static_cast<std::uint32_t>(p);
+        if (g.state.inv_mass[p] == 0) continue;  // pinned: no sphere
+        const Vec3 model = to_model * Vec3(g.state.x.col(p));
+        const std::vector<BoneInfluence> influences = trunk_influences(*body, *skin->mesh, model.cast<double>());
+        double total = 0;
+        for (std::size_t i = 0; i < influences.size() && i < 4; ++i) total += influences[i].weight;
+        if (!(total > 0)) return;
+        for (std::size_t i = 0; i < influences.size() && i < 4; ++i) {
+            b.bones[static_cast<Eigen::Index>(i)] = influences[i].bone;
+            b.weights[static_cast<Eigen::Index>(i)] = static_cast<Real>(influences[i].weight / total);
+        }
+        const Affine3 m = blend_skinning(skeleton->skinning, b.bones, b.weights);
+        if (!(std::abs(m.linear().determinant()) > Real(1e-8))) return;
+        b.kind = PinKind::skinned;
+        b.local = m.inverse() * model;
+    }
+    g.body.rest_on_skin = std::move(bound);
+}
+
 // Pins the particles `pinned` marks (grid order, line * m + row), pushes the rest out of
 // the colliders, records the rest shape, and adds the garment to the registry.
 Result<Entity> finish(Registry& registry, Garment g, const std::vector<std::uint8_t>& pinned, PinWeights pin_weights) {
@@ -299,6 +338,7 @@ Result<Entity> finish(Registry& registry, Garment g, const std::vector<std::uint
     state.v.setZero();
     const Affine3 anchor = anchor_frame(solver.frames, g.body.anchor);
     g.body.rest_local = anchor.inverse(Eigen::Isometry) * state.x;
+    bind_rest_to_skin(registry, g);
     update_pin_targets(registry, g, solver, true);
     if (!state.x.allFinite()) return fail(std::string("garment placement produced non-finite positions"));
     const Entity e = registry.create();

@@ -149,6 +149,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
                                "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall); the downward part beyond it is carried rigidly; 0: no bound")),
         for_file_garments(real("max_distance_share", &TubeParams::max_distance_share, closed(0, 10), "",
                                "> 0: each particle stays within this x the rest length of its line up to its pin of where it hangs in the rest shape, carried by the body (a max distance, as Unity Cloth's; 1: the hem swings up to 60 degrees, never past its pins); 0: none")),
+        for_file_garments(integer("max_distance_on_skin", &TubeParams::max_distance_on_skin, closed(0, 1),
+                                  "with `max_distance_share`, 1: each sphere's centre is the particle's rest place carried by the skin of the trunk and legs nearest it (a raised thigh carries it, as skinned constraints do); 0: carried by the anchor (the pelvis)")),
         real("thin_trunk_piece_m", &TubeParams::thin_trunk_piece_m, closed(0, 1), "m",
              "> 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is at most this (pieces that stand between neighbouring particles and hold the cloth open; the anchor's kept); 0: with every ellipsoid"),
         real("areal_density_kg_m2", &ClothMaterial::areal_density_kg_m2, open_min(0, 10), "kg/m^2",

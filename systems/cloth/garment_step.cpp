@@ -152,6 +152,8 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
     // the substep (prepare_collision placed the colliders there).
     const Real max_distance = g.config.max_distance_share;
     const bool spheres = tethers && max_distance > 0 && g.body.rest_local.cols() == x.cols();
+    // Or round the rest places as the skin carries them (max_distance_on_skin; pins.hpp).
+    const bool on_skin = spheres && s.sphere_target.cols() == x.cols();
     const Affine3 anchor = spheres ? anchor_frame(s.frames, g.body.anchor) : Affine3::Identity();
     // The springs joining two bands first, on this thread (none in a garment of one band).
     for (SpringSet& set : s.springs) {
@@ -174,7 +176,11 @@ void constrain_round(Garment& g, GarmentSolver& s, const ClothSubstep& sub, int 
                     set, k, s.x_rows, s.inv_mass, h, g.config.material.line_iterations, g.config.material.line_tolerance));
         }
         if (tethers) solve_tethers(s.tethers[k], s.x_rows);
-        if (spheres) solve_max_distance(s.tethers[k], g.body.rest_local, anchor, max_distance, s.x_rows);
+        if (spheres && on_skin)
+            solve_max_distance(s.tethers[k], s.sphere_previous, s.sphere_target, Real(sub.index + 1) / Real(sub.count),
+                               g.body.rest_local, anchor, max_distance, s.x_rows);
+        else if (spheres)
+            solve_max_distance(s.tethers[k], g.body.rest_local, anchor, max_distance, s.x_rows);
         if (write_back)
             for (const ParticleRun& r : s.parts.runs[k])
                 x.middleCols(r.begin, r.end - r.begin) = s.x_rows.middleCols(r.begin, r.end - r.begin);

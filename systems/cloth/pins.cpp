@@ -49,7 +49,59 @@ Result<Vec3> evaluate_pin(const Registry& registry, const Garment& garment, cons
     return fail("pin: unknown kind");
 }
 
+namespace {
+
+// GarmentConfig::max_distance_on_skin: each particle's rest place as the skin carries it now
+// (a skinned pin's rule; pinned particles have no sphere and keep their rest place).
+void update_sphere_targets(const Registry& registry, const Garment& g, GarmentSolver& s, bool snap) {
+    const std::vector<PinBinding>& bound = g.body.rest_on_skin;
+    const Eigen::Index n = g.state.x.cols();
+    const auto* skeleton = registry.try_get<Skeleton>(g.body.character);
+    if (!(g.config.max_distance_share > 0) || !g.config.max_distance_on_skin || static_cast<Eigen::Index>(bound.size()) != n ||
+        skeleton == nullptr) {
+        s.sphere_previous.resize(3, 0);
+        s.sphere_target.resize(3, 0);
+        return;
+    }
+    const bool first = s.sphere_target.cols() != n || s.sphere_previous.cols() != n;
+    if (first) {
+        s.sphere_previous = g.state.x;  // where a particle without a binding keeps its centre
+        s.sphere_target.resize(3, n);
+    } else {
+        s.sphere_previous.swap(s.sphere_target);
+    }
+    // Each bone's skinning and the character's Transform in one map, once per step; a place is
+    // then the weighted sum of its bones' images (linear blend skinning, as blend_skinning).
+    const auto* transform = registry.try_get<Transform>(g.body.character);
+    const Affine3 world = transform ? transform->matrix() : Affine3::Identity();
+    const std::size_t bones = skeleton->skinning.size();
+    std::vector<Affine3> to_world(bones);
+    for (std::size_t b = 0; b < bones; ++b) to_world[b] = world * skeleton->skinning[b];
+    const std::size_t parts = s.parts.count;
+    for_each_part(parts, [&](std::size_t k) {
+        const Eigen::Index begin = n * static_cast<Eigen::Index>(k) / static_cast<Eigen::Index>(parts);
+        const Eigen::Index end = n * static_cast<Eigen::Index>(k + 1) / static_cast<Eigen::Index>(parts);
+        for (Eigen::Index p = begin; p < end; ++p) {
+            const PinBinding& b = bound[static_cast<std::size_t>(p)];
+            bool ok = b.kind == PinKind::skinned;
+            for (int i = 0; i < 4 && ok; ++i) ok = b.weights[i] == 0 || (b.bones[i] >= 0 && static_cast<std::size_t>(b.bones[i]) < bones);
+            if (!ok) {
+                s.sphere_target.col(p) = s.sphere_previous.col(p);
+                continue;
+            }
+            Vec3 at = Vec3::Zero();
+            for (int i = 0; i < 4; ++i)
+                if (b.weights[i] != 0) at += b.weights[i] * (to_world[static_cast<std::size_t>(b.bones[i])] * b.local);
+            s.sphere_target.col(p) = at;
+        }
+    });
+    if (first || snap) s.sphere_previous = s.sphere_target;
+}
+
+}  // namespace
+
 void update_pin_targets(const Registry& registry, const Garment& g, GarmentSolver& s, bool snap) {
+    update_sphere_targets(registry, g, s, snap);
     const std::vector<PinBinding>& pins = g.state.pins;
     const Eigen::Index n = static_cast<Eigen::Index>(pins.size());
     const bool first = s.pin_target.cols() != n;

@@ -22,8 +22,10 @@ namespace drape {
 /// World position of a pin now, or an error naming what is missing (collider, skeleton, bone).
 [[nodiscard]] Result<Vec3> evaluate_pin(const Registry& registry, const Garment& garment, const PinBinding& pin);
 
-/// Sets every pin's target for the new fixed step (previous <- last target). On the first
-/// step, or when `snap`, previous = target. A pin that cannot be evaluated keeps its last target.
+/// Sets every pin's target for the new fixed step (previous <- last target), and with
+/// GarmentConfig::max_distance_on_skin the spheres' centres (GarmentSolver::sphere_target).
+/// On the first step, or when `snap`, previous = target. A pin that cannot be evaluated keeps
+/// its last target.
 void update_pin_targets(const Registry& registry, const Garment& garment, GarmentSolver& solver, bool snap);
 
 /// Moves the pinned particles to fraction (substep + 1) / substeps of the step.

@@ -51,5 +51,42 @@ TEST(MaxDistance, AParticleOutsideItsSphereGoesOntoItOneInsideStays) {
     EXPECT_NEAR((Vec3(x.col(2)) - place2).norm(), 5, 1e-4);
 }
 
+// On the skin (GarmentConfig::max_distance_on_skin) each centre is given per particle, at the
+// start and the end of the fixed step; a substep takes its share of the way between them, and
+// a centre the skin carried above the anchor's place for it is lowered to that height.
+TEST(MaxDistance, CentresGivenPerParticleAreTakenAtTheSubstepsShareOfTheStepNeverAboveTheAnchors) {
+    Tethers tethers;
+    tethers.particle = {1, 2};
+    tethers.anchor = {0, 0};
+    tethers.length_m = {Real(0.2), Real(0.5)};
+    Matrix3X previous = Matrix3X::Zero(3, 3), target = Matrix3X::Zero(3, 3);
+    previous.col(1) = Vec3(0, Real(-0.2), 0);
+    target.col(1) = Vec3(Real(0.4), Real(-0.2), 0);  // carried 0.4 m along x over the step
+    previous.col(2) = target.col(2) = Vec3(0, Real(-0.5), 0);
+    Matrix3X rest_local = previous;  // the anchor's places: where the step started
+    const Affine3 anchor = Affine3::Identity();
+    Matrix3XRows x(3, 3);
+    x.col(0) = Vec3::Zero();
+    x.col(1) = Vec3(0, Real(-0.2), 0);              // at its centre at the start of the step
+    x.col(2) = Vec3(0, Real(-0.3), 0);              // 0.2 m from its centre: inside 0.5
+    // A quarter of the way: the centre at x = 0.1, within 0.2 of it: stays.
+    solve_max_distance(tethers, previous, target, Real(0.25), rest_local, anchor, 1, x);
+    EXPECT_TRUE(Vec3(x.col(1)).isApprox(Vec3(0, Real(-0.2), 0)));
+    // The whole way: the centre at x = 0.4, 0.4 away: pulled onto its sphere toward it.
+    solve_max_distance(tethers, previous, target, 1, rest_local, anchor, 1, x);
+    EXPECT_TRUE(Vec3(x.col(1)).isApprox(Vec3(Real(0.2), Real(-0.2), 0), Real(1e-5))) << Vec3(x.col(1)).transpose();
+    EXPECT_TRUE(Vec3(x.col(2)).isApprox(Vec3(0, Real(-0.3), 0)));
+    // A leg lifts particle 2's centre 0.6 m, to 0.1 m above the pin: the sphere stays at the
+    // anchor's height, 0.5 m under the pin, and a particle lifted with the leg comes down onto it.
+    target.col(2) = Vec3(0, Real(0.1), 0);
+    x.col(2) = Vec3(0, Real(0.1), 0);
+    solve_max_distance(tethers, target, target, 1, rest_local, anchor, 1, x);
+    EXPECT_LT(Vec3(x.col(2)).norm(), 1e-5) << Vec3(x.col(2)).transpose();  // onto the pin's height
+    // Centres for another number of particles: nothing is done.
+    x.col(1) = Vec3(5, 5, 5);
+    solve_max_distance(tethers, Matrix3X::Zero(3, 2), Matrix3X::Zero(3, 2), 1, rest_local, anchor, 1, x);
+    EXPECT_TRUE(Vec3(x.col(1)).isApprox(Vec3(5, 5, 5)));
+}
+
 }  // namespace
 }  // namespace drape
