@@ -271,7 +271,11 @@ Result<World> build_world(const SceneDescription& scene, const WorldOptions& opt
             const std::string& why = garment.error().message;
             return fail(located(g.where, why.starts_with(field + ": ") ? std::string() : field, why));
         }
-        world.registry.get<Garment>(*garment).config.warp_solve = g.warp_solve;
+        Garment& made = world.registry.get<Garment>(*garment);
+        made.config.warp_solve = g.warp_solve;
+        if (made.config.max_distance_share > 0 && made.config.max_distance_on_skin && made.body.rest_on_skin.empty())
+            world.warnings.push_back(field + ".max_distance_on_skin: the character has no skin of trunk and legs to bind the spheres to; "
+                                             "the anchor carries them");
         world.garments.push_back(*garment);
         // A mesh of the character's own file that is now cloth is not drawn skinned too.
         if (auto* skin = world.registry.try_get<SkinnedMesh>(body); skin && skin->mesh)

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "analytic_body.hpp"
 #include "drape/systems/cloth/constraints.hpp"
+#include "drape/systems/cloth/garment_builder.hpp"
 
 namespace drape {
 namespace {
@@ -86,6 +88,29 @@ TEST(MaxDistance, CentresGivenPerParticleAreTakenAtTheSubstepsShareOfTheStepNeve
     x.col(1) = Vec3(5, 5, 5);
     solve_max_distance(tethers, Matrix3X::Zero(3, 2), Matrix3X::Zero(3, 2), 1, rest_local, anchor, 1, x);
     EXPECT_TRUE(Vec3(x.col(1)).isApprox(Vec3(5, 5, 5)));
+}
+
+// On a body without a skin (the analytic body: ellipsoids only) there is nothing to bind the
+// spheres to: the anchor carries them, the skirt moving exactly as one built that way.
+TEST(MaxDistance, OnTheSkinWithoutASkinTheAnchorCarriesTheSpheres) {
+    Matrix3X x[2];
+    for (int on_skin = 0; on_skin < 2; ++on_skin) {
+        Registry registry;
+        test::AnalyticBody body(registry);
+        TubeParams params = TubeParams::skirt();
+        params.max_distance_share = Real(0.5);
+        params.max_distance_on_skin = on_skin;
+        const Entity e = *attach_skirt(registry, body.character, params);
+        Garment& g = registry.get<Garment>(e);
+        GarmentSolver& solver = registry.get<GarmentSolver>(e);
+        EXPECT_EQ(g.config.max_distance_on_skin, on_skin == 1);
+        EXPECT_TRUE(g.body.rest_on_skin.empty());
+        test::step_by_hand(body, registry, g, solver, 60);
+        EXPECT_EQ(solver.sphere_target.cols(), 0);
+        EXPECT_TRUE(g.state.x.allFinite());
+        x[on_skin] = g.state.x;
+    }
+    EXPECT_EQ(x[0], x[1]);
 }
 
 }  // namespace
