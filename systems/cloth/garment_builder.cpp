@@ -160,6 +160,27 @@ Real hem_leg_half_width(std::span<const EllipsoidFrame> frames, std::span<const 
     return thinnest;
 }
 
+// A point (model space) bound to the skin at its closest point there (trunk_skin.hpp), by the
+// four strongest weights of that point, normalised: a skinned binding, its particle unset.
+// Nothing where the skin gives no weight or the bones' blend cannot be inverted.
+std::optional<PinBinding> bind_to_skin_surface(const TrunkSkin& skin, const MeshAsset& mesh, const std::vector<Affine3>& skinning,
+                                               const Vec3& model) {
+    const std::vector<BoneInfluence> influences = trunk_influences(skin, mesh, model.cast<double>());
+    double total = 0;
+    for (std::size_t i = 0; i < influences.size() && i < 4; ++i) total += influences[i].weight;
+    if (!(total > 0)) return std::nullopt;
+    PinBinding b;
+    for (std::size_t i = 0; i < influences.size() && i < 4; ++i) {
+        b.bones[static_cast<Eigen::Index>(i)] = influences[i].bone;
+        b.weights[static_cast<Eigen::Index>(i)] = static_cast<Real>(influences[i].weight / total);
+    }
+    const Affine3 m = blend_skinning(skinning, b.bones, b.weights);
+    if (!(std::abs(m.linear().determinant()) > Real(1e-8))) return std::nullopt;
+    b.kind = PinKind::skinned;
+    b.local = m.inverse() * model;
+    return b;
+}
+
 // Binds pinned particle p (world position x) to the body (method §3.5).
 PinBinding bind_pin(const Registry& registry, Entity character, const std::vector<Entity>& colliders,
                     std::span<const EllipsoidFrame> frames, const TrunkSkin* trunk, const MeshAsset& mesh, std::uint32_t p,
@@ -186,15 +207,10 @@ PinBinding bind_pin(const Registry& registry, Entity character, const std::vecto
         Vec4 weights = Vec4::Zero();
         bool found = false;
         if (trunk) {
-            // PinWeights::skin_surface: at the closest point of the trunk's skin, by its
-            // weights there (trunk_skin.hpp), the four strongest.
-            const std::vector<BoneInfluence> influences = trunk_influences(*trunk, mesh, model.cast<double>());
-            double total = 0;
-            for (std::size_t i = 0; i < influences.size() && i < 4; ++i) total += influences[i].weight;
-            for (std::size_t i = 0; i < influences.size() && i < 4 && total > 0; ++i) {
-                bones[static_cast<Eigen::Index>(i)] = influences[i].bone;
-                weights[static_cast<Eigen::Index>(i)] = static_cast<Real>(influences[i].weight / total);
-                found = true;
+            // PinWeights::skin_surface: at the closest point of the trunk's skin.
+            if (std::optional<PinBinding> on_skin = bind_to_skin_surface(*trunk, mesh, skeleton->skinning, model)) {
+                on_skin->particle = p;
+                return *on_skin;
             }
         }
         const auto* skin = registry.try_get<SkinnedMesh>(character);
@@ -290,19 +306,10 @@ void bind_rest_to_skin(const Registry& registry, Garment& g) {
         PinBinding& b = bound[static_cast<std::size_t>(p)];
         b.particle = static_cast<std::uint32_t>(p);
         if (g.state.inv_mass[p] == 0) continue;  // pinned: no sphere
-        const Vec3 model = to_model * Vec3(g.state.x.col(p));
-        const std::vector<BoneInfluence> influences = trunk_influences(*body, *skin->mesh, model.cast<double>());
-        double total = 0;
-        for (std::size_t i = 0; i < influences.size() && i < 4; ++i) total += influences[i].weight;
-        if (!(total > 0)) return;
-        for (std::size_t i = 0; i < influences.size() && i < 4; ++i) {
-            b.bones[static_cast<Eigen::Index>(i)] = influences[i].bone;
-            b.weights[static_cast<Eigen::Index>(i)] = static_cast<Real>(influences[i].weight / total);
-        }
-        const Affine3 m = blend_skinning(skeleton->skinning, b.bones, b.weights);
-        if (!(std::abs(m.linear().determinant()) > Real(1e-8))) return;
-        b.kind = PinKind::skinned;
-        b.local = m.inverse() * model;
+        std::optional<PinBinding> on_skin = bind_to_skin_surface(*body, *skin->mesh, skeleton->skinning, to_model * Vec3(g.state.x.col(p)));
+        if (!on_skin) return;
+        b = *on_skin;
+        b.particle = static_cast<std::uint32_t>(p);
     }
     g.body.rest_on_skin = std::move(bound);
 }

@@ -121,6 +121,7 @@ struct GarmentSolver {
     /// GarmentConfig::max_distance_on_skin: the spheres' centres (GarmentBody::rest_on_skin
     /// skinned) at the start and end of the fixed step, one per particle; else empty.
     Matrix3X sphere_previous, sphere_target;
+    std::vector<Affine3> sphere_bones;       ///< Scratch: each bone's skinning in world space, for the spheres.
     std::vector<EllipsoidFrame> pin_frames;  ///< Scratch: the colliders at the end of the fixed step, for the pins.
     Vec3 anchor_velocity_before = Vec3::Zero();      ///< The anchor's V when the velocities were last written.
     Vec3 anchor_velocity_earlier = Vec3::Zero();     ///< Its V one fixed step before that (the fall bound's two-step acceleration).

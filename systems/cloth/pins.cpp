@@ -75,7 +75,8 @@ void update_sphere_targets(const Registry& registry, const Garment& g, GarmentSo
     const auto* transform = registry.try_get<Transform>(g.body.character);
     const Affine3 world = transform ? transform->matrix() : Affine3::Identity();
     const std::size_t bones = skeleton->skinning.size();
-    std::vector<Affine3> to_world(bones);
+    std::vector<Affine3>& to_world = s.sphere_bones;
+    to_world.resize(bones);
     for (std::size_t b = 0; b < bones; ++b) to_world[b] = world * skeleton->skinning[b];
     const std::size_t parts = s.parts.count;
     for_each_part(parts, [&](std::size_t k) {
