@@ -977,7 +977,12 @@ Real ground_height(const Registry& registry) {
 std::uint64_t collide_ground(Matrix3X& x, const VectorX& inv_mass, Real ground_m, Eigen::Index first, Eigen::Index end,
                              Matrix3X* push) {
     std::uint64_t moved = 0;
-    if (!(ground_m > -std::numeric_limits<Real>::infinity())) return moved;
+    if (!(ground_m > -std::numeric_limits<Real>::infinity()) || end <= first) return moved;
+    // Most rounds nothing is near the floor: the lowest particle first, without a branch.
+    Real lowest = std::numeric_limits<Real>::infinity();
+    const Real* y = x.data() + 1;
+    for (Eigen::Index p = first; p < end; ++p) lowest = std::min(lowest, y[3 * p]);
+    if (!(lowest < ground_m)) return moved;
     for (Eigen::Index p = first; p < end; ++p) {
         const Real below = ground_m - x(1, p);
         if (!(below > 0) || inv_mass[p] == 0) continue;
