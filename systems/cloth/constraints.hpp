@@ -106,13 +106,6 @@ void solve_springs(SpringSet& set, std::size_t band, Matrix3XRows& x, const Vect
 void solve_edge_springs(SpringSet& set, Matrix3X& x, const VectorX& inv_mass, Real h_s, Real limit);
 void solve_edge_springs(SpringSet& set, Matrix3XRows& x, const VectorX& inv_mass, Real h_s, Real limit);
 
-// The warp and weft limits hold the springs within this share of Provot's limit, leaving
-// the rest of the limit to what the last collision does after them. Lower, the warp limit
-// acts on a garment at rest (the rounds leave a line hanging a few percent long over the
-// hips) and dynamic follow-the-leader's velocity correction then keeps it moving: at 2 % of
-// stretch the skirt on a still body kept 1 cm/s, at 5 % it comes to rest (docs/cloth.md).
-inline constexpr Real limit_share = Real(0.5);
-
 /// Long-range attachments (step 2): one per free particle below a pinned one on its line.
 struct Tethers {
     std::vector<std::uint32_t> particle;  ///< The free particle.

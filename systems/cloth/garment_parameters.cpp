@@ -166,6 +166,8 @@ std::span<const GarmentParameterSpec> garment_parameters() {
              "Provot's largest relative over-stretch (method §4.1); 0.1 = 10 %"),
         real("compression_limit", &ClothMaterial::compression_limit, closed(0, 1), "",
              "the shortest a spring may become over its rest length, the cloth's folds being coarser than its grid; 0 = none"),
+        real("limit_share", &ClothMaterial::limit_share, open_min(0, 1), "",
+             "the share of `strain_limit` within which the warp and weft limits hold a spring each substep (the rest is left to the collision after them); at 1 a spring below Provot's limit is the stretch modulus's alone"),
         integer("iterations", &ClothMaterial::iterations, closed(1, 100),
                 "constraint and collision rounds per substep (Gauss-Seidel)"),
         integer("weft_bend", &ClothMaterial::weft_bend, closed(0, 1),

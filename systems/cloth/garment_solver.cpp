@@ -129,7 +129,7 @@ void prepare_solver(const Garment& g, GarmentSolver& s) {
         s.weft_rest_right = weft_rest_right(t);
         Tethers tethers = build_tethers(t, state.inv_mass, s.warp_rest_above);
         if (lines)  // the warp limit's slack, so that a line can stretch as far as its springs may
-            for (Real& l : tethers.length_m) l *= 1 + limit_share * m.strain_limit;
+            for (Real& l : tethers.length_m) l *= 1 + m.limit_share * m.strain_limit;
         s.tethers = split_tethers(tethers, parts.band, parts.count);
         s.part_counters.assign(parts.count, PartCounters{});
         s.line_steps.assign(parts.count, 0);

@@ -255,7 +255,7 @@ void finish_constraints(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
         paper_constraints(g, s, sub);
         return;
     }
-    const Real stretch = limit_share * g.config.material.strain_limit;
+    const Real stretch = g.config.material.limit_share * g.config.material.strain_limit;
     for_each_part(s.parts.count, [&](std::size_t k) {
         const auto [first_line, end_line] = s.parts.lines[k];
         s.part_counters[k].warp_moved =
@@ -612,6 +612,7 @@ void repair_pushes(Garment& g, GarmentSolver& s, const ClothSubstep& sub) {
     const Fabric& f = *g.fabric;
     const std::uint32_t m = f.particles_per_line;
     const Real limit = g.config.material.strain_limit;
+    const Real limit_share = g.config.material.limit_share;
     const Real stretch = limit_share * limit;
     // The compression limit as the strain limit: a spring shorter than it is chosen, and
     // pushed apart to within limit_share of it.

@@ -22,14 +22,15 @@ TEST(GarmentParameterTable, NamesAreUniqueAndFoundByName) {
         EXPECT_LT(spec.range.min, spec.range.max) << spec.name;
     }
     EXPECT_EQ(find_garment_parameter("waist_height_m"), nullptr);
-    // Every ClothMaterial field a garment carries is a row (13 of them, weft bending included), and so is every
+    // Every ClothMaterial field a garment carries is a row (14 of them, weft bending and the
+    // limits' share included), and so is every
     // numeric field of TubeParams (20, the inertia scales with their acceleration and fall
     // bounds, the max distance and its centres on the skin, the hem clearance, the line
     // spacing and the thin trunk pieces included).
     int material = 0;
     for (const GarmentParameterSpec& spec : garment_parameters()) material += spec.in_material();
-    EXPECT_EQ(material, 13);
-    EXPECT_EQ(garment_parameters().size(), 33u);
+    EXPECT_EQ(material, 14);
+    EXPECT_EQ(garment_parameters().size(), 34u);
 }
 
 TEST(MaterialPresets, AreValidDistinctAndFoundByName) {
