@@ -10,15 +10,15 @@
 //      are solved line by line instead (solve_lines), each line's springs at once.
 //   2. Tethers: a free particle no farther from the pinned particle at the top of its warp
 //      line than the rest length of the line between them (with WarpSolve::lines, that
-//      times 1 + limit_share x limit; long-range attachments, as Jolt
+//      times 1 + ClothMaterial::limit_share x limit; long-range attachments, as Jolt
 //      and NvCloth hang cloth from its pins: a few Gauss-Seidel rounds cannot carry a long
 //      line's weight up to its pin, the tether does it in one).
 //   3. With a max distance (GarmentConfig::max_distance_share), each tethered particle back
 //      within its sphere round its rest place carried by the anchor (solve_max_distance).
-// After the rounds, once per substep, limit_warp_lines holds every warp spring within half
-// the limit by a one-sided pass from the pins down (follow the leader), then
-// limit_weft_rows holds every weft row the same, each run of over-long springs solved as
-// one chain.
+// After the rounds, once per substep, limit_warp_lines holds every warp spring within
+// ClothMaterial::limit_share (half) of the limit by a one-sided pass from the pins down
+// (follow the leader), then limit_weft_rows holds every weft row the same, each run of
+// over-long springs solved as one chain.
 // Positions only: the velocities follow from the whole substep's move afterwards
 // (garment_step.hpp), as Provot's velocities follow his corrections.
 #pragma once
