@@ -538,27 +538,32 @@ bool find_crushed(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, st
 }
 
 // The springs shorter than `shortest` x their rest length with a free end whose first end
-// lies on the lines [first, end), appended to `out` as find_crushed gives them. Every spring
-// is looked at once (grid order: the spring to the particle below, then to the next line),
-// not only those of particles that moved: the limits' moves can crush a spring they do not
-// stretch, and so can the rounds (a collision putting two neighbours on one point of a
+// lies on the lines [first, end), appended to `out` as find_crushed gives them (the caller
+// sorts them). Every spring is looked at once, not only those of particles that moved: the
+// limits' moves can crush a spring they do not stretch, and so can the rounds (a collision putting two neighbours on one point of a
 // surface; in the classic model the shear and bend springs pressing a weft spring at the hem).
 void find_crushed_lines(const Fabric& f, const GarmentSolver& s, const Matrix3X& x, std::pair<std::uint32_t, std::uint32_t> lines,
                         Real shortest, std::vector<std::uint64_t>& out) {
     if (!(shortest > 0)) return;
     const std::uint32_t m = f.particles_per_line, n = f.warp_lines;
     const VectorX& w = s.inv_mass;
-    const auto check = [&](std::uint32_t p, std::uint32_t q, Real rest) {
-        if ((w[p] != 0 || w[q] != 0) && is_crushed(x, p, q, rest, shortest)) out.push_back(spring_key(p, q));
-    };
-    for (std::uint32_t line = lines.first; line < lines.second; ++line) {
-        const std::uint32_t* here = f.grid.data() + std::size_t(line) * m;
-        const bool right = n > 1 && (line + 1 < n || f.closed);
-        const std::uint32_t* next = f.grid.data() + std::size_t((line + 1) % n) * m;
-        for (std::uint32_t row = 0; row < m; ++row) {
-            const std::uint32_t p = here[row];
-            if (row + 1 < m) check(p, here[row + 1], s.warp_rest_above[here[row + 1]]);
-            if (right) check(p, next[row], s.weft_rest_right[p]);
+    const Real* rest_above = s.warp_rest_above.data();
+    const Real* rest_right = s.weft_rest_right.data();
+    // Row by row, the way the particles are stored; a crushed spring is rare, so the test
+    // runs without a branch and the few found are looked at after.
+    for (std::uint32_t row = 0; row < m; ++row) {
+        const bool down = row + 1 < m;
+        for (std::uint32_t line = lines.first; line < lines.second; ++line) {
+            const std::uint32_t p = f.grid[std::size_t(line) * m + row];
+            const std::uint32_t q_down = f.grid[std::size_t(line) * m + (down ? row + 1 : row)];
+            const bool right = n > 1 && (line + 1 < n || f.closed);
+            const std::uint32_t q_right = f.grid[std::size_t(right ? (line + 1) % n : line) * m + row];
+            const bool crushed_down = down & is_crushed(x, p, q_down, rest_above[q_down], shortest);
+            const bool crushed_right = right & is_crushed(x, p, q_right, rest_right[p], shortest);
+            if (!(crushed_down | crushed_right)) [[likely]]
+                continue;
+            if (crushed_down && (w[p] != 0 || w[q_down] != 0)) out.push_back(spring_key(p, q_down));
+            if (crushed_right && (w[p] != 0 || w[q_right] != 0)) out.push_back(spring_key(p, q_right));
         }
     }
 }
