@@ -80,6 +80,7 @@ Timed make_timed(const Garment& base, const Config& c, int paper_substeps) {
     Timed t;
     t.garment = base;
     t.garment.config.integrator = c.integrator;
+    if (c.integrator == paper) t.garment.config.inertia.max_fall_m_s2 = 0;  // eq. 2 as written: the body's whole acceleration
     t.garment.config.model = c.model;
     t.garment.config.collision = c.collision;
     if (c.fixed) t.settings.fixed_substeps = c.integrator == paper ? paper_substeps : table_substeps;

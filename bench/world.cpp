@@ -30,6 +30,8 @@ SceneDescription scene_for(const WorldSpec& spec) {
         g.warp_solve = spec.warp_solve;
         g.collision = spec.collision;
         if (spec.particles > 0) g.parameters.push_back({"particles", static_cast<double>(spec.particles)});
+        // The paper's scheme as written: eq. 2 feels the body's whole acceleration.
+        if (spec.integrator == ClothIntegrator::paper) g.parameters.push_back({"inertia_max_fall_m_s2", 0.0});
         scene.garments.push_back(g);
     }
     scene.solver.substeps = spec.substeps;

@@ -149,12 +149,13 @@ struct InertiaScales {
     /// dead from 8 m/s at a jump's top). 0: no bound.
     Real max_linear_m_s2 = 0;
     /// > 0: the fastest the particles feel the anchor accelerate downward, along gravity, over
-    /// its last two fixed steps (m/s^2; free fall, 9.81, is the most a body that only pushes
-    /// on the ground can do; a clip keyed at 30 Hz moves every other step at 60): the
-    /// downward part of a step's felt acceleration beyond it is carried rigidly, the rest of
-    /// the motion felt as `linear` and `max_linear_m_s2` say (an animated jump's root rising
-    /// at 8 m/s and stopping dead at its top is a body pulled down at 30 g). 0: no bound.
-    Real max_fall_m_s2 = 0;
+    /// its last two fixed steps (m/s^2; free fall, 9.81, the default, is the most a body that
+    /// only pushes on the ground can do; a clip keyed at 30 Hz moves every other step at 60):
+    /// the downward part of a step's felt acceleration beyond it is carried rigidly, the rest
+    /// of the motion felt as `linear` and `max_linear_m_s2` say (an animated jump's root
+    /// rising at 8 m/s and stopping dead at its top is a body pulled down at 30 g). 0: no
+    /// bound, eq. 2's whole -m a (the paper's scheme as written).
+    Real max_fall_m_s2 = Real(9.81);
     friend bool operator==(const InertiaScales&, const InertiaScales&) = default;
 };
 

@@ -146,7 +146,7 @@ std::span<const GarmentParameterSpec> garment_parameters() {
         for_file_garments(real("inertia_max_linear_m_s2", &TubeParams::inertia_max_linear_m_s2, closed(0, 1e4), "m/s^2",
                                "> 0: the most of the body's linear acceleration the cloth feels (x `inertia_linear`); beyond it the rest is carried rigidly (an animated jump stopping dead at its top); 0: no bound")),
         for_file_garments(real("inertia_max_fall_m_s2", &TubeParams::inertia_max_fall_m_s2, closed(0, 1e4), "m/s^2",
-                               "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall); the downward part beyond it is carried rigidly; 0: no bound")),
+                               "> 0: the fastest downward acceleration of the body the cloth feels, along gravity (9.81: free fall, which no body that only pushes on the ground outruns); the downward part beyond it is carried rigidly; 0: no bound, the whole -m a of method §3.3")),
         for_file_garments(real("max_distance_share", &TubeParams::max_distance_share, closed(0, 10), "",
                                "> 0: each particle stays within this x the rest length of its line up to its pin of where it hangs in the rest shape, carried by the body (a max distance, as Unity Cloth's; 1: the hem swings up to 60 degrees, never past its pins); 0: none")),
         for_file_garments(integer("max_distance_on_skin", &TubeParams::max_distance_on_skin, closed(0, 1),
