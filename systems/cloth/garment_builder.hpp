@@ -70,10 +70,10 @@ struct TubeParams {
     Real ring_height_m = 0;           ///< > 0: ring height above the body's lowest point.
     Real torso_radius_fraction = Real(0.12);  ///< Colliders centred farther than this x height from the axis (arms) are not outline.
     int fitting_rows = 1;             ///< Rows pinned to the body (method §3.5).
-    Real inertia_linear = 1;          ///< InertiaScales::linear of the garment (1: physical).
-    Real inertia_angular = 1;         ///< InertiaScales::angular.
-    Real inertia_max_linear_m_s2 = 0; ///< InertiaScales::max_linear_m_s2 (0: no bound).
-    Real inertia_max_fall_m_s2 = Real(9.81);  ///< InertiaScales::max_fall_m_s2: free fall (0: no bound).
+    Real inertia_linear = InertiaScales{}.linear;                    ///< InertiaScales::linear of the garment (1: physical).
+    Real inertia_angular = InertiaScales{}.angular;                  ///< InertiaScales::angular.
+    Real inertia_max_linear_m_s2 = InertiaScales{}.max_linear_m_s2;  ///< InertiaScales::max_linear_m_s2 (0: no bound).
+    Real inertia_max_fall_m_s2 = InertiaScales{}.max_fall_m_s2;      ///< InertiaScales::max_fall_m_s2: free fall (0: no bound).
     Real max_distance_share = 0;      ///< GarmentConfig::max_distance_share (0: none).
     int max_distance_on_skin = 0;     ///< 1: GarmentConfig::max_distance_on_skin (the spheres follow the skin of trunk and legs).
     Real thin_trunk_piece_m = 0;      ///< > 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is at
