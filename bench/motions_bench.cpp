@@ -255,6 +255,7 @@ nlohmann::json row_json(const RunResult& r) {
     j["skin_penetration_p99_m"] = r.stats.skin_penetration_p99_m;
     j["skin_penetration_share"] = r.stats.skin_penetration_share;
     j["rise_above_pins_m"] = r.stats.rise_above_pins_m;
+    j["speed_max_m_s"] = r.stats.speed_max_m_s;
     j["nonfinite"] = r.stats.nonfinite;
     j["resets"] = r.stats.resets;
     j["ms_p50"] = r.ms_p50;

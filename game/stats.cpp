@@ -45,6 +45,19 @@ WorstSpring worst_spring(const Registry& registry, const Garment& g, const Garme
     return w;
 }
 
+// The largest speed a free particle's stored velocity gives it (NaN when one is not finite).
+double fastest_free_particle(const Garment& g) {
+    double fastest = 0;
+    const Eigen::Index n = std::min(g.state.v.cols(), g.state.inv_mass.size());
+    for (Eigen::Index p = 0; p < n; ++p) {
+        if (g.state.inv_mass[p] == 0) continue;
+        const double speed = g.state.v.col(p).norm();
+        if (!(speed <= fastest)) fastest = speed;  // a NaN is kept
+        if (std::isnan(fastest)) break;
+    }
+    return fastest;
+}
+
 }  // namespace
 
 void GarmentWatch::sample(const Registry& registry) {
@@ -69,6 +82,7 @@ void GarmentWatch::sample(const Registry& registry) {
         worse(w.pins_inside_m, q.pins_inside_m);
         worse(w.below_ground_m, q.below_ground_m);
         worse(w.rise_above_pins_m, q.rise_above_pins_m);
+        worse(w.speed_max_m_s, fastest_free_particle(*g));
         if (std::isnan(q.compression_min) || q.compression_min < w.compression_min) w.compression_min = q.compression_min;
         w.repair_rounds_max = std::max(w.repair_rounds_max, g->counters.frame_repair_rounds);
         w.substeps_max = std::max(w.substeps_max, g->counters.substeps);
@@ -180,6 +194,7 @@ std::string stats_json(const RunStats& stats) {
                                              : Json{{"p99", nullptr}, {"max", nullptr}, {"share", nullptr}}},
                             {"pins_inside_m", number(g.pins_inside_m)},
                             {"rise_above_pins_m", number(g.rise_above_pins_m)},
+                            {"speed_max_m_s", number(g.speed_max_m_s)},
                             {"nonfinite", g.nonfinite},
                             {"resets", g.resets},
                             {"collision_tests_per_frame", number(g.collision_tests_per_frame)},

@@ -10,7 +10,7 @@
 //                  "penetration_m": {"after_frame_max", "before_response_max", "within_give_max",
 //                                    "below_ground_max"},
 //                  "skin_penetration_m": {"p99", "max", "share"},
-//                  "pins_inside_m", "rise_above_pins_m", "nonfinite", "resets",
+//                  "pins_inside_m", "rise_above_pins_m", "speed_max_m_s", "nonfinite", "resets",
 //                  "collision_tests_per_frame", "line_steps_per_frame", "max_strain",
 //                  "max_penetration_m"}]}
 //
@@ -28,7 +28,8 @@
 // `skin_penetration_m` is cloth behind the character's skin mesh (game/skin_penetration.hpp):
 // p99 and max of the depths of the free particles found behind it after each frame, and
 // their share of all free particles over every frame; null when not measured (`drape play`
-// measures it with --stats).
+// measures it with --stats). `speed_max_m_s` is the fastest free particle's stored velocity
+// after a frame (in the world), the speed the next step starts it with.
 #pragma once
 
 #include <cstdint>
@@ -81,6 +82,7 @@ struct GarmentStats {
     double skin_penetration_max_m = 0;   ///< Deepest free particle behind the skin after a frame.
     double skin_penetration_share = 0;   ///< Share of free particles behind the skin, over every frame.
     double rise_above_pins_m = 0;        ///< Highest free particle above the highest pin after a frame.
+    double speed_max_m_s = 0;            ///< Fastest free particle's stored velocity after a frame (world), m/s.
     std::uint64_t nonfinite = 0;         ///< Non-finite values the cloth found and reset, plus any left in x or v.
     std::uint64_t resets = 0;            ///< Garment resets during the run (non-finite state, teleports, requests).
     double collision_tests_per_frame = 0;///< Particle-ellipsoid tests per rendered frame, mean.

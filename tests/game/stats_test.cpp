@@ -55,6 +55,7 @@ RunStats example() {
     r.garments.back().skin_penetration_p99_m = 0.004;
     r.garments.back().skin_penetration_max_m = 0.006;
     r.garments.back().skin_penetration_share = 0.01;
+    r.garments.back().speed_max_m_s = 12.5;
     r.garments.back().worst_spring = {.seen = true, .frame = 12, .weft = true, .line = 58, .row = 26, .rows = 84,
                                       .body_part = "torso", .part_thickness_m = 0.01, .straddles = true};
     return r;
@@ -83,7 +84,8 @@ TEST(StatsFile, HasExactlyTheDocumentedFields) {
                                                  "line_steps_per_frame", "max_penetration_m", "max_strain", "nonfinite",
                                                  "particles", "penetration_m",
                                                  "pins_inside_m", "repair_rounds_max", "resets", "rise_above_pins_m",
-                                                 "skin_penetration_m", "strain", "substeps_max", "substeps_mean"}));
+                                                 "skin_penetration_m", "speed_max_m_s", "strain", "substeps_max", "substeps_mean"}));
+    EXPECT_DOUBLE_EQ(g["speed_max_m_s"].get<double>(), 12.5);
     EXPECT_DOUBLE_EQ(g["compression_min"].get<double>(), 0.8);
     EXPECT_DOUBLE_EQ(g["substeps_mean"].get<double>(), 1.5);
     EXPECT_EQ(g["substeps_max"], 4);
@@ -201,6 +203,29 @@ TEST(GarmentWatch, StrainIsMeasuredOnTheGarmentAfterTheFrame) {
     EXPECT_EQ(worst.rows, 4u);
     EXPECT_TRUE(worst.body_part.empty());
     EXPECT_FALSE(worst.straddles);
+}
+
+// The fastest free particle's stored velocity over the run: a pinned particle's is not the
+// cloth's, and a later, slower frame does not lower it.
+TEST(GarmentWatch, ReportsTheFastestFreeParticle) {
+    Registry registry;
+    RectangleParams params;
+    params.warp_lines = 4;
+    params.particles_per_line = 4;
+    const Entity e = *attach_rectangle(registry, params);
+    Garment& g = registry.get<Garment>(e);
+    GarmentWatch watch(registry, {e});
+    const Fabric& t = *g.fabric;
+    const std::uint32_t pinned = t.grid[0], hem = t.grid[3];  // line 0: the top row is pinned
+    ASSERT_EQ(g.state.inv_mass[pinned], 0);
+    ASSERT_GT(g.state.inv_mass[hem], 0);
+    g.state.v.setZero();
+    g.state.v.col(pinned) = Vec3(0, 0, 90);
+    g.state.v.col(hem) = Vec3(3, 0, 4);
+    watch.sample(registry);
+    g.state.v.col(hem) = Vec3(0, 1, 0);
+    watch.sample(registry);
+    EXPECT_NEAR(watch.result(registry)[0].speed_max_m_s, 5.0, 1e-6);
 }
 
 TEST(StatsFile, NoWorstSpringIsWrittenAsNull) {
