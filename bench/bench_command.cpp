@@ -133,7 +133,7 @@ void add_bench_command(CLI::App& app) {
                         "The shipped solver's warp springs: rounds (default) or lines (motions, stability; docs/cloth.md)")
         ->check(CLI::IsMember({"rounds", "lines"}));
     command->add_option("--thicken-thin-trunk", cli->thicken_thin_trunk_m,
-                        "M: the body fit thickens trunk pieces at most M thin inward to the thick ones (motions; default 0: "
+                        "M: the body fit thickens trunk shells at most M thin inward to the thick ones (motions; default 0: "
                         "none; docs/cloth.md)")
         ->check(CLI::Range(0.0, 0.1));
     command->add_option("--pin-weights", cli->pin_weights,

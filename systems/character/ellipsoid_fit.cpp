@@ -582,6 +582,10 @@ void thicken_thin_trunk_pieces(std::vector<EllipsoidShape>& shapes, std::span<co
     if (!(thin > 0)) return;
     const Real tolerance = static_cast<Real>(options.tolerance_m);
     constexpr Real reach_m = Real(0.12), step_m = Real(0.002);  // how far behind a shell the thick pieces are looked for
+    // A shell covers a patch of skin: its middle radius is at least this times its thin one.
+    // Balls and rods (on a loose shirt's folds) are left: grown inward, they tore
+    // Male_LongSleeve's running skirts (docs/cloth.md, "Collision").
+    constexpr Real shell_ratio = 2;
     const auto trunk = [](const EllipsoidShape& e) { return e.region == BodyRegion::torso || e.region == BodyRegion::pelvis; };
     const auto posed = [&](const EllipsoidShape& e) { return e.bone >= 0 && static_cast<std::size_t>(e.bone) < global.size(); };
     // Unit-sphere maps of the thick trunk pieces, as they are before any is changed.
@@ -594,6 +598,9 @@ void thicken_thin_trunk_pieces(std::vector<EllipsoidShape>& shapes, std::span<co
         int axis = 0;
         const Real r0 = s.radii_m.minCoeff(&axis);
         if (r0 > thin) continue;
+        Vec3 sorted = s.radii_m;
+        std::sort(sorted.data(), sorted.data() + 3);
+        if (sorted[1] < shell_ratio * r0) continue;  // a ball or a rod on a fold, not a shell
         const Affine3 bone = rigid_part(global[static_cast<std::size_t>(s.bone)]);
         const Affine3 placed = ellipsoid_transform(s, global[static_cast<std::size_t>(s.bone)]);
         const Vec3 c = placed.translation();

@@ -97,7 +97,7 @@ struct FitOptions {
     double arm_reach_m = -1;               ///< An upper or lower arm's ellipsoid may pass its own skin along the arm by this much (< 0, the default: no limit; docs/cloth.md, "Body fit").
     LegFit legs = LegFit::automatic;       ///< How the legs are fitted (see the header comment).
     double knee_radius_share = 1.2;        ///< Tight legs: a sphere at each knee, this x the joint's distance to the nearest leg skin (0: none).
-    double thicken_thin_trunk_m = 0;       ///< > 0: trunk pieces at most this thin are thickened inward to the thick ones (thicken_thin_trunk_pieces; 0: none).
+    double thicken_thin_trunk_m = 0;       ///< > 0: trunk shells at most this thin are thickened inward to the thick ones (thicken_thin_trunk_pieces; 0: none).
 };
 
 /// Checks the options; the error names the field.
@@ -113,8 +113,9 @@ struct FitOptions {
 /// Bone of each vertex: the index with the largest weight.
 [[nodiscard]] std::vector<int> dominant_bones(const MeshAsset& mesh);
 
-/// Trunk pieces (torso, pelvis) at most FitOptions::thicken_thin_trunk_m thin are shells
-/// under the skin; between one and the thick trunk pieces lies body that no ellipsoid
+/// Trunk pieces (torso, pelvis) at most FitOptions::thicken_thin_trunk_m thin whose middle
+/// radius is at least twice the thin one are shells under the skin (smaller balls and rods
+/// are left as they are); between one and the thick trunk pieces lies body that no ellipsoid
 /// covers, where cloth that slips in past the shell's edge is held on both of its faces (a
 /// spring across the shell). Each is made thicker along its thin axis, inward (away from the
 /// way the skin within `tolerance_m` of it faces, by its normals), until its inner face is

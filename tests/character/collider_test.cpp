@@ -172,7 +172,8 @@ TEST(EllipsoidFitting, HipBoneIsFoundByNameOrByTheLegs) {
 // bone), its skin facing out (+x): thickened inward, its outer face's middle stays at
 // 14 cm and its inner face goes the tolerance (1 cm) into the sphere; the same shell with
 // its skin facing the other way is thickened the other way, and one with no thick piece
-// within reach behind it, or a thicker piece, or a piece off the trunk, is left as it was.
+// within reach behind it, or a thicker piece, a rod (its middle radius under twice its thin
+// one), or a piece off the trunk, is left as it was.
 TEST(EllipsoidFitting, ThinTrunkPiecesAreThickenedInwardToTheThickOnes) {
     const std::vector<Affine3> global = {Affine3(Eigen::Translation<Real, 3>(Vec3(0, 1, 0)))};
     EllipsoidShape sphere;
@@ -211,17 +212,18 @@ TEST(EllipsoidFitting, ThinTrunkPiecesAreThickenedInwardToTheThickOnes) {
     EXPECT_NEAR(shapes[1].center.x() - shapes[1].radii_m.x(), 0.12f, 1e-5f);  // its inner (-x) face stays
     EXPECT_EQ(shapes[1].radii_m.x(), 0.01f) << "nothing thick within reach behind it (+x)";
 
-    // Far from the thick piece, thicker than the option, off the trunk, or the option off.
-    skin(Vec3::UnitX(), p, n);
+    // Far from the thick piece, thicker than the option, a rod, off the trunk, or the option off.
     for (const auto& change : std::vector<std::function<void(EllipsoidShape&, FitOptions&)>>{
              [](EllipsoidShape& e, FitOptions&) { e.center.x() += 0.2f; },
              [](EllipsoidShape& e, FitOptions&) { e.radii_m.x() = 0.02f; },
+             [](EllipsoidShape& e, FitOptions&) { e.radii_m.y() = 0.015f; },
              [](EllipsoidShape& e, FitOptions&) { e.region = BodyRegion::upper_arm; },
              [](EllipsoidShape&, FitOptions& o) { o.thicken_thin_trunk_m = 0; }}) {
         EllipsoidShape e = shell;
         FitOptions o = options;
         change(e, o);
-        if (e.center.x() > 0.2f) skin(Vec3::UnitX(), p, n), p.row(0).array() += 0.2f;
+        skin(Vec3::UnitX(), p, n);  // the skin on the shell's outer face, moved with a moved shell
+        if (e.center.x() > 0.2f) p.row(0).array() += 0.2f;
         shapes = {sphere, e};
         thicken_thin_trunk_pieces(shapes, global, p, n, o);
         EXPECT_EQ(shapes[1].radii_m, e.radii_m);
