@@ -17,6 +17,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A rectangle of 4 lines of 4 particles, pinned at its top, hanging in the air.
+Entity attach_small_rectangle(Registry& registry) {
+    RectangleParams params;
+    params.warp_lines = 4;
+    params.particles_per_line = 4;
+    return *attach_rectangle(registry, params);
+}
+
 std::vector<std::string> keys(const nlohmann::json& j) {
     std::vector<std::string> out;
     for (const auto& [k, v] : j.items()) out.push_back(k);
@@ -141,10 +149,7 @@ TEST(StatsFile, IsWrittenWholeOrNotAtAll) {
 
 TEST(GarmentWatch, ReportsWorstValuesAfterEachFrameAndNonFiniteParticles) {
     Registry registry;
-    RectangleParams params;
-    params.warp_lines = 4;
-    params.particles_per_line = 4;
-    const Entity e = *attach_rectangle(registry, params);
+    const Entity e = attach_small_rectangle(registry);
     Garment& g = registry.get<Garment>(e);
     g.counters.collision_tests = 100;  // before the run: not counted
     GarmentWatch watch(registry, {e});
@@ -178,10 +183,7 @@ TEST(GarmentWatch, ReportsWorstValuesAfterEachFrameAndNonFiniteParticles) {
 
 TEST(GarmentWatch, StrainIsMeasuredOnTheGarmentAfterTheFrame) {
     Registry registry;
-    RectangleParams params;
-    params.warp_lines = 4;
-    params.particles_per_line = 4;
-    const Entity e = *attach_rectangle(registry, params);
+    const Entity e = attach_small_rectangle(registry);
     Garment& g = registry.get<Garment>(e);
     GarmentWatch watch(registry, {e});
     const Fabric& t = *g.fabric;
@@ -209,10 +211,7 @@ TEST(GarmentWatch, StrainIsMeasuredOnTheGarmentAfterTheFrame) {
 // cloth's, and a later, slower frame does not lower it.
 TEST(GarmentWatch, ReportsTheFastestFreeParticle) {
     Registry registry;
-    RectangleParams params;
-    params.warp_lines = 4;
-    params.particles_per_line = 4;
-    const Entity e = *attach_rectangle(registry, params);
+    const Entity e = attach_small_rectangle(registry);
     Garment& g = registry.get<Garment>(e);
     GarmentWatch watch(registry, {e});
     const Fabric& t = *g.fabric;
