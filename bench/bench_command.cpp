@@ -16,6 +16,7 @@
 
 #include "bench/report.hpp"
 #include "drape/game/commands.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 #include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape {
@@ -52,7 +53,7 @@ std::string quoted_command(int runs, int threads, const bench::BenchOptions& o, 
     for (const auto& [name, value] : o.garment_parameters) c += " --garment-param " + name + "=" + parameter_number_text(value);
     if (o.start_s > 0) c += " --start " + parameter_number_text(o.start_s);
     if (o.warp_solve == WarpSolve::lines) c += " --warp-solve lines";
-    if (o.thicken_thin_trunk_m > 0) c += " --thicken-thin-trunk " + parameter_number_text(o.thicken_thin_trunk_m);
+    if (o.thicken_thin_trunk_m) c += " --thicken-thin-trunk " + parameter_number_text(*o.thicken_thin_trunk_m);
     if (o.pin_weights) c += std::string(" --pin-weights ") + bench::pin_weights_name(*o.pin_weights);
     return c;
 }
@@ -109,7 +110,7 @@ void add_bench_command(CLI::App& app) {
         std::vector<std::string> garment_params;
         double start_s = 0;
         std::string warp_solve;
-        double thicken_thin_trunk_m = 0;
+        double thicken_thin_trunk_m = default_thicken_thin_trunk_m;
         std::string pin_weights;
     };
     auto cli = std::make_shared<Cli>();
@@ -133,8 +134,8 @@ void add_bench_command(CLI::App& app) {
                         "The shipped solver's warp springs: rounds (default) or lines (motions, stability; docs/cloth.md)")
         ->check(CLI::IsMember({"rounds", "lines"}));
     command->add_option("--thicken-thin-trunk", cli->thicken_thin_trunk_m,
-                        "M: the body fit thickens trunk shells at most M thin inward to the thick ones (motions; default 0: "
-                        "none; docs/cloth.md)")
+                        "M: the body fit thickens trunk shells at most M thin inward to the thick ones (motions; 0: none; "
+                        "default: as shipped, " + parameter_number_text(default_thicken_thin_trunk_m) + "; docs/cloth.md)")
         ->check(CLI::Range(0.0, 0.1));
     command->add_option("--pin-weights", cli->pin_weights,
                         "Skinned pins take the nearest skin vertex's weights or the skin's where they sit (motions; default: as "
@@ -173,7 +174,7 @@ void add_bench_command(CLI::App& app) {
         } limited[] = {{!garment_parameters.empty(), "--garment-param", {"motions", "cut"}},
                        {cli->start_s > 0, "--start", {"stability"}},
                        {!cli->warp_solve.empty(), "--warp-solve", {"motions", "stability"}},
-                       {cli->thicken_thin_trunk_m > 0, "--thicken-thin-trunk", {"motions"}},
+                       {command->count("--thicken-thin-trunk") > 0, "--thicken-thin-trunk", {"motions"}},
                        {!cli->pin_weights.empty(), "--pin-weights", {"motions"}}};
         for (const auto& l : limited) {
             if (!l.given || std::find(l.takers.begin(), l.takers.end(), cli->name) != l.takers.end()) continue;
@@ -203,7 +204,7 @@ void add_bench_command(CLI::App& app) {
             options.garment_parameters = garment_parameters;
             options.start_s = cli->start_s;
             options.warp_solve = cli->warp_solve == "lines" ? WarpSolve::lines : WarpSolve::rounds;
-            options.thicken_thin_trunk_m = cli->thicken_thin_trunk_m;
+            if (command->count("--thicken-thin-trunk") > 0) options.thicken_thin_trunk_m = cli->thicken_thin_trunk_m;
             if (!cli->pin_weights.empty())
                 options.pin_weights = cli->pin_weights == "skin_surface" ? PinWeights::skin_surface : PinWeights::nearest_vertex;
             if (!cli->json.empty())

@@ -35,6 +35,7 @@
 #include "drape/engine/render/image.hpp"
 #include "drape/game/asset_paths.hpp"
 #include "drape/game/contract.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 #include "drape/systems/cloth/garment_parameters.hpp"
 
 #ifdef DRAPE_HAVE_RENDER
@@ -115,7 +116,7 @@ struct RunOptions {
     int threads = 1;
     std::vector<std::pair<std::string, double>> garment_parameters;  ///< BenchOptions::garment_parameters.
     WarpSolve warp_solve = WarpSolve::rounds;                        ///< BenchOptions::warp_solve.
-    double thicken_thin_trunk_m = 0;                                 ///< BenchOptions::thicken_thin_trunk_m.
+    double thicken_thin_trunk_m = default_thicken_thin_trunk_m;      ///< BenchOptions::thicken_thin_trunk_m.
     std::optional<PinWeights> pin_weights;                           ///< BenchOptions::pin_weights.
     bool render = false;
     std::vector<int> grab_frames;     ///< Frames to render (with render).
@@ -126,7 +127,7 @@ RunOptions run_options(const BenchOptions& options) {
     ro.threads = options.threads;
     ro.garment_parameters = options.garment_parameters;
     ro.warp_solve = options.warp_solve;
-    ro.thicken_thin_trunk_m = options.thicken_thin_trunk_m;
+    ro.thicken_thin_trunk_m = options.thicken_thin_trunk_m.value_or(default_thicken_thin_trunk_m);
     ro.pin_weights = options.pin_weights;
     return ro;
 }
@@ -522,7 +523,7 @@ Result<void> run_motions(const BenchOptions& options) {
     nlohmann::json json = {{"frames", run_frames}, {"starts", starts}, {"threads", options.threads},
                            {"filter", options.filter}, {"garment_parameters", garment_parameters_json},
                            {"warp_solve", options.warp_solve == WarpSolve::lines ? "lines" : "rounds"},
-                           {"thicken_thin_trunk_m", options.thicken_thin_trunk_m},
+                           {"thicken_thin_trunk_m", options.thicken_thin_trunk_m.value_or(default_thicken_thin_trunk_m)},
                            {"pin_weights", pin_weights_name(options.pin_weights.value_or(GarmentDescription{}.pin_weights))},
                            {"runs", rows_json}};
     return finish(report, options, json);

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "drape/game/scene_description.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 #include "drape/systems/cloth/garment_parameters.hpp"
 
 namespace drape::bench {
@@ -54,9 +55,11 @@ std::string changed_parameters(const BenchOptions& options) {
     for (const auto& [name, value] : options.garment_parameters)
         text += (text.empty() ? " but " : ", ") + name + " = " + parameter_number_text(value);
     if (options.warp_solve == WarpSolve::lines) text += (text.empty() ? " but " : ", ") + std::string("warp lines solved directly");
-    if (options.thicken_thin_trunk_m > 0)
-        text += (text.empty() ? " but " : ", ") + std::string("trunk pieces at most ") + parameter_number_text(options.thicken_thin_trunk_m) +
-                " m thin thickened inward";
+    if (options.thicken_thin_trunk_m && *options.thicken_thin_trunk_m != default_thicken_thin_trunk_m)
+        text += (text.empty() ? " but " : ", ") +
+                (*options.thicken_thin_trunk_m > 0
+                     ? "trunk shells at most " + parameter_number_text(*options.thicken_thin_trunk_m) + " m thin thickened inward"
+                     : std::string("no trunk shell thickened"));
     if (options.pin_weights && *options.pin_weights != GarmentDescription{}.pin_weights)
         text += (text.empty() ? " but " : ", ") + std::string("pins weighted by the ") +
                 (*options.pin_weights == PinWeights::skin_surface ? "skin surface under them" : "nearest skin vertex");

@@ -41,8 +41,8 @@ struct BenchOptions {
     /// stability only).
     WarpSolve warp_solve = WarpSolve::rounds;
     /// The characters' body fit: FitOptions::thicken_thin_trunk_m (`--thicken-thin-trunk`;
-    /// motions only; 0: none, as shipped).
-    double thicken_thin_trunk_m = 0;
+    /// motions only; 0: none; unset: as shipped, default_thicken_thin_trunk_m).
+    std::optional<double> thicken_thin_trunk_m;
     /// How the garments' skinned pins are bound (`--pin-weights`; motions only; none: as
     /// shipped, GarmentDescription::pin_weights).
     std::optional<PinWeights> pin_weights;

@@ -16,6 +16,7 @@
 
 #include "drape/components/garment.hpp"
 #include "drape/engine/core/math.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 #include "drape/systems/cloth/garment_from_mesh.hpp"
 
 namespace drape {
@@ -46,7 +47,7 @@ struct CharacterDescription {
     bool in_place = true;                ///< true: the walk stays in place; false: root motion moves the character.
     double start_s = 0;                  ///< Clip time at the start (where in its cycle the character begins), s.
     bool hide_modelled_garments = true;  ///< Garments modelled into the file are not drawn while a garment is simulated on the character.
-    double thicken_thin_trunk_m = 0;     ///< The body fit's FitOptions::thicken_thin_trunk_m (0: none; docs/cloth.md, "Collision").
+    double thicken_thin_trunk_m = default_thicken_thin_trunk_m;  ///< The body fit's FitOptions::thicken_thin_trunk_m (0: none; docs/cloth.md, "Collision").
     std::filesystem::path motion;        ///< A BVH file whose motion drives the character (retargeted) instead of its clips; empty: none.
     std::vector<std::pair<std::string, std::string>> motion_bones;  ///< Motion joint -> bone, before the built-in matching.
     SourceLocation where;                ///< Of the "file" field, for load errors.

@@ -714,7 +714,7 @@ std::string to_json(const SceneDescription& scene) {
         o["in_place"] = c.in_place;
         if (c.start_s != 0) o["start_s"] = c.start_s;
         if (!c.hide_modelled_garments) o["hide_modelled_garments"] = false;
-        if (c.thicken_thin_trunk_m != 0) o["thicken_thin_trunk_m"] = c.thicken_thin_trunk_m;
+        if (c.thicken_thin_trunk_m != default_thicken_thin_trunk_m) o["thicken_thin_trunk_m"] = c.thicken_thin_trunk_m;
         if (!c.motion.empty()) o["motion"] = c.motion.string();
         if (!c.motion_bones.empty()) {
             OrderedJson bones = OrderedJson::object();

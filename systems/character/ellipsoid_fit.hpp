@@ -82,6 +82,10 @@ enum class LegFit : std::uint8_t {
     bounding,   ///< One ellipsoid per leg bone bounding its vertices.
 };
 
+/// Trunk shells at most this thin are thickened inward by default (FitOptions::thicken_thin_trunk_m;
+/// chosen on Female_TankTop's, Male_Casual's and Male_LongSleeve's pieces: docs/cloth.md, "Collision").
+inline constexpr double default_thicken_thin_trunk_m = 0.015;
+
 /// How ellipsoids are fitted (the numeric details are ellipsoid_solver.hpp's).
 struct FitOptions {
     double min_cluster_fraction = 0.004;   ///< A bone with fewer of the vertices than this merges into its parent.
@@ -97,7 +101,7 @@ struct FitOptions {
     double arm_reach_m = -1;               ///< An upper or lower arm's ellipsoid may pass its own skin along the arm by this much (< 0, the default: no limit; docs/cloth.md, "Body fit").
     LegFit legs = LegFit::automatic;       ///< How the legs are fitted (see the header comment).
     double knee_radius_share = 1.2;        ///< Tight legs: a sphere at each knee, this x the joint's distance to the nearest leg skin (0: none).
-    double thicken_thin_trunk_m = 0;       ///< > 0: trunk shells at most this thin are thickened inward to the thick ones (thicken_thin_trunk_pieces; 0: none).
+    double thicken_thin_trunk_m = default_thicken_thin_trunk_m;  ///< > 0: trunk shells at most this thin are thickened inward to the thick ones (thicken_thin_trunk_pieces; 0: none).
 };
 
 /// Checks the options; the error names the field.

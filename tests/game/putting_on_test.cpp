@@ -97,15 +97,14 @@ TEST(PuttingOn, ADressPutOnMidStrideStartsWithinTheContract) {
 // should start within the contract: not flung (rise above the pins, penetration, nothing
 // non-finite, no reset) and not torn. Which of them fails depends on the rounding of the
 // build (docs/characters.md). In the tests' build (DRAPE_ARCH x86-64-v3, AMD EPYC), with the
-// fall bound on (its default), 9 of the 12 hold; all three that fail are torn, none flung:
-// Female_TankTop's put on 0.2 s into her run (68.7 %, frame 13) and Female_Alternative's at
-// 0.2 s (85.8 %, frame 20), each by a warp spring straddling a trunk piece 1.0 cm thin (the
-// class docs/cloth.md's thin trunk pieces describe), and Female_Alternative's at 0.1 s
-// (129.2 %, frame 19) by a weft spring of the hem over her lower leg. With the thin pieces
-// thickened inward (the body fit's thicken_thin_trunk_m 0.015, not the default)
-// Female_TankTop's held and Male_LongSleeve's three runs tore (80-156 %, before the fall
-// bound). Rendered, no dress is over the chest or the face. Disabled until every run holds
-// (the motion suite, docs/reports/motions.md); run it with --gtest_also_run_disabled_tests.
+// fall bound on and the trunk's thin shells thickened inward (both defaults), 9 of the 12
+// hold; all three that fail are torn, none flung: Female_TankTop's put on 0.1 s into her run
+// (34.4 %) and Female_Alternative's at 0.1 s (129.2 %, frame 19, a weft spring of the hem over
+// her lower leg) and 0.2 s (85.8 %, frame 20, a warp spring straddling a trunk piece 1.0 cm
+// thin that the body fit leaves as it is). Before the shells were thickened, Female_TankTop's at 0.2 s tore
+// (68.7 %) and her 0.1 s held. Rendered, no dress is over the chest or the face. Disabled until
+// every run holds (the motion suite, docs/reports/motions.md); run it with
+// --gtest_also_run_disabled_tests.
 TEST(PuttingOn, DISABLED_ADressPutOnARunningCharacterStartsWithinTheContract) {
     const std::pair<const char*, const char*> runs[] = {{"characters/female_tanktop/Female_TankTop.fbx", "Female_Run"},
                                                         {"characters/female_alternative/Female_Alternative.fbx", "Female_Run"},

@@ -48,7 +48,7 @@ constexpr const char* valid_scene = R"({
   "characters": [
     {"file": "chars/body.glb", "clip": "Walk", "scale": 1.0, "position_m": [0, 0, 0],
      "rotation_deg": [0, 90, 0], "speed": 1.25, "in_place": true},
-    {"file": "chars/body.glb", "clip": 2, "position_m": [1.5, 0, -0.5], "in_place": false, "thicken_thin_trunk_m": 0.015}
+    {"file": "chars/body.glb", "clip": 2, "position_m": [1.5, 0, -0.5], "in_place": false, "thicken_thin_trunk_m": 0}
   ],
   "garments": [
     {"type": "skirt", "character": 0, "model": "simplified", "collision": "lists",
@@ -75,8 +75,8 @@ TEST_F(SceneFileTest, ValidFileIsReadCompletely) {
     EXPECT_DOUBLE_EQ(scene->characters[0].speed, 1.25);
     EXPECT_FALSE(scene->characters[1].in_place);
     EXPECT_FLOAT_EQ(scene->characters[1].position_m.x(), 1.5f);
-    EXPECT_EQ(scene->characters[0].thicken_thin_trunk_m, 0.0);
-    EXPECT_DOUBLE_EQ(scene->characters[1].thicken_thin_trunk_m, 0.015);
+    EXPECT_EQ(scene->characters[0].thicken_thin_trunk_m, default_thicken_thin_trunk_m);
+    EXPECT_EQ(scene->characters[1].thicken_thin_trunk_m, 0.0);
     // Yaw 90 degrees turns +Z to +X.
     EXPECT_TRUE((scene->characters[0].rotation() * Vec3::UnitZ()).isApprox(Vec3::UnitX(), 1e-5f));
     ASSERT_EQ(scene->garments.size(), 3u);
