@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drape/engine/assets/character_import.hpp"
 #include "drape/systems/character/pose.hpp"
 
 namespace drape {
@@ -80,7 +81,7 @@ std::string character_report_text(const CharacterAsset& c, const CharacterBody& 
         const AnimationClip& clip = *c.clips[i];
         out += format("    [%zu] %-32s %7.3f s  %3zu channels", i, clip.name.c_str(), clip.duration_s, clip.channels.size());
         if (clip.travel_m.norm() > 1e-3f) out += format("  travels %.2f m", double(clip.travel_m.norm()));
-        out += "\n";
+        out += clip_loops(clip) ? "  loops\n" : "  plays once\n";
     }
     out += format("  ellipsoids  %zu fitted, legs %s\n", body.ellipsoids.size(), leg_fit_name(body.legs));
     for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {
@@ -140,7 +141,7 @@ std::string character_report_json(const CharacterAsset& c, const CharacterBody& 
     j["clips"] = json::array();
     for (const auto& clip : c.clips)
         j["clips"].push_back({{"name", clip->name}, {"duration_s", clip->duration_s}, {"channels", clip->channels.size()},
-                              {"travel_m", {clip->travel_m.x(), clip->travel_m.y(), clip->travel_m.z()}}});
+                              {"loops", clip_loops(*clip)}, {"travel_m", {clip->travel_m.x(), clip->travel_m.y(), clip->travel_m.z()}}});
     j["legs"] = leg_fit_name(body.legs);
     j["ellipsoids"] = json::array();
     for (std::size_t i = 0; i < body.ellipsoids.size(); ++i) {

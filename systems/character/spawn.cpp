@@ -55,9 +55,9 @@ Result<Entity> spawn_character(Registry& registry, std::shared_ptr<const Charact
     AnimationPlayer& player = registry.emplace<AnimationPlayer>(e);
     player.clip = clip;
     player.speed = options.speed;
-    player.loop = options.loop;
+    player.loop = options.loop.value_or(clip && clip_loops(*clip));
     player.in_place = options.in_place;
-    player.time_s = clip ? wrap_clip_time(options.start_time_s, clip->duration_s, options.loop).time_s : 0;
+    player.time_s = clip ? wrap_clip_time(options.start_time_s, clip->duration_s, player.loop).time_s : 0;
     Skeleton& skeleton = registry.emplace<Skeleton>(e);
     skeleton.asset = asset->skeleton;
     advance_animation(player, skeleton, &transform, 0);  // pose at the start time

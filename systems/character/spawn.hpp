@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,9 @@ struct SpawnOptions {
     Transform transform;
     std::string clip;                  ///< Name or index; empty = choose_default_clip() (a walk when there is one; no clips: rest pose).
     double speed = 1;                  ///< Playback rate.
-    bool loop = true;
+    /// Whether the clip loops; unset: when clip_loops() says so (its first and last poses within
+    /// 15 degrees), else it plays once and holds its last pose (a fall, a sit, a jump).
+    std::optional<bool> loop;
     bool in_place = true;              ///< false: root motion moves the Transform.
     double start_time_s = 0;           ///< Where in the clip to start.
     std::vector<EllipsoidShape> collider_overrides;  ///< Replace the fitted ellipsoids of their bones (or add).

@@ -1,11 +1,16 @@
 // The clip a character plays when none is named: a walk, else a looping run or other
-// locomotion, else an idle, else the first clip; spawning without a clip plays it.
+// locomotion, else an idle, else the first clip; spawning without a clip plays it. A clip
+// loops when its ends meet; one that goes somewhere plays once and holds its last pose.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <optional>
+#include <utility>
 
 #include "drape/components/animation_player.hpp"
+#include "drape/components/skeleton.hpp"
 #include "drape/engine/assets/character_import.hpp"
+#include "drape/systems/character/animation.hpp"
 #include "drape/systems/character/character_body.hpp"
 #include "drape/systems/character/spawn.hpp"
 #include "tests/character/test_character_file.hpp"
@@ -108,6 +113,39 @@ TEST(DefaultClip, SpawnWithoutAClipPlaysTheChoice) {
     auto f = spawn_character(registry, asset, *body, named);
     ASSERT_TRUE(f) << f.error().message;
     EXPECT_EQ(registry.get<AnimationPlayer>(*f).clip->name, "Bend");
+}
+
+// A fall or a sit ends far from its first pose: looped, the character would jump back up at
+// every wrap and fling its garment. Spawned without saying, it plays once and holds its last
+// pose; a clip whose ends meet loops; SpawnOptions::loop overrides either.
+TEST(DefaultClip, AClipThatGoesSomewherePlaysOnceAndHoldsItsLastPose) {
+    const auto dir = test::temp_dir("clip_once");
+    test::write_test_character({}, dir / "column.gltf");
+    auto imported = import_character(dir / "column.gltf");
+    std::filesystem::remove_all(dir);
+    ASSERT_TRUE(imported) << imported.error().message;
+    auto asset = std::make_shared<CharacterAsset>(**imported);
+    asset->clips = {clip("Walk"), clip("Fall", 1.5f)};
+    const auto body = fit_character_body(*asset);
+    ASSERT_TRUE(body) << body.error().message;
+    Registry registry;
+    // Played 1.25 clip lengths from 0.5 s in: the walk wraps to 0.75 s, the fall stops at its end.
+    const auto played = [&](const char* name, std::optional<bool> loop) {
+        SpawnOptions o;
+        o.clip = name;
+        o.loop = loop;
+        o.start_time_s = 0.5;
+        auto e = spawn_character(registry, asset, *body, o);
+        EXPECT_TRUE(e) << e.error().message;
+        auto& player = registry.get<AnimationPlayer>(*e);
+        auto& skeleton = registry.get<Skeleton>(*e);
+        advance_animation(player, skeleton, nullptr, 1.25);
+        return std::pair{player.loop, player.time_s};
+    };
+    EXPECT_EQ(played("Walk", std::nullopt), std::pair(true, 0.75));
+    EXPECT_EQ(played("Fall", std::nullopt), std::pair(false, 1.0));
+    EXPECT_EQ(played("Fall", true), std::pair(true, 0.75));
+    EXPECT_EQ(played("Walk", false), std::pair(false, 1.0));
 }
 
 }  // namespace
