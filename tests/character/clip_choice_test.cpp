@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "drape/components/animation_player.hpp"
 #include "drape/components/skeleton.hpp"
@@ -93,24 +94,35 @@ TEST(DefaultClip, ThenAnIdleThenTheFirstClip) {
     EXPECT_FALSE(choose_default_clip(with_clips({})));
 }
 
-TEST(DefaultClip, SpawnWithoutAClipPlaysTheChoice) {
+// The test column (test_character_file.hpp) with its clip "Bend" first, then `clips`, and its
+// fitted body.
+void column_with(std::vector<std::shared_ptr<const AnimationClip>> clips, std::shared_ptr<CharacterAsset>& asset,
+                 CharacterBody& body) {
     const auto dir = test::temp_dir("clip_choice");
     test::write_test_character({}, dir / "column.gltf");
     auto imported = import_character(dir / "column.gltf");
     std::filesystem::remove_all(dir);
     ASSERT_TRUE(imported) << imported.error().message;
-    auto asset = std::make_shared<CharacterAsset>(**imported);
-    asset->clips = {(*imported)->clips.front(), clip("Walk")};  // "Bend" first, then a walk
-    const auto body = fit_character_body(*asset);
-    ASSERT_TRUE(body) << body.error().message;
+    asset = std::make_shared<CharacterAsset>(**imported);
+    clips.insert(clips.begin(), (*imported)->clips.front());
+    asset->clips = std::move(clips);
+    auto fitted = fit_character_body(*asset);
+    ASSERT_TRUE(fitted) << fitted.error().message;
+    body = *fitted;
+}
+
+TEST(DefaultClip, SpawnWithoutAClipPlaysTheChoice) {
+    std::shared_ptr<CharacterAsset> asset;
+    CharacterBody body;
+    ASSERT_NO_FATAL_FAILURE(column_with({clip("Walk")}, asset, body));  // "Bend" first, then a walk
     Registry registry;
-    auto e = spawn_character(registry, asset, *body);
+    auto e = spawn_character(registry, asset, body);
     ASSERT_TRUE(e) << e.error().message;
     ASSERT_TRUE(registry.get<AnimationPlayer>(*e).clip);
     EXPECT_EQ(registry.get<AnimationPlayer>(*e).clip->name, "Walk");
     SpawnOptions named;
     named.clip = "Bend";
-    auto f = spawn_character(registry, asset, *body, named);
+    auto f = spawn_character(registry, asset, body, named);
     ASSERT_TRUE(f) << f.error().message;
     EXPECT_EQ(registry.get<AnimationPlayer>(*f).clip->name, "Bend");
 }
@@ -119,15 +131,9 @@ TEST(DefaultClip, SpawnWithoutAClipPlaysTheChoice) {
 // every wrap and fling its garment. Spawned without saying, it plays once and holds its last
 // pose; a clip whose ends meet loops; SpawnOptions::loop overrides either.
 TEST(DefaultClip, AClipThatGoesSomewherePlaysOnceAndHoldsItsLastPose) {
-    const auto dir = test::temp_dir("clip_once");
-    test::write_test_character({}, dir / "column.gltf");
-    auto imported = import_character(dir / "column.gltf");
-    std::filesystem::remove_all(dir);
-    ASSERT_TRUE(imported) << imported.error().message;
-    auto asset = std::make_shared<CharacterAsset>(**imported);
-    asset->clips = {clip("Walk"), clip("Fall", 1.5f)};
-    const auto body = fit_character_body(*asset);
-    ASSERT_TRUE(body) << body.error().message;
+    std::shared_ptr<CharacterAsset> asset;
+    CharacterBody body;
+    ASSERT_NO_FATAL_FAILURE(column_with({clip("Walk"), clip("Fall", 1.5f)}, asset, body));
     Registry registry;
     // Played 1.25 clip lengths from 0.5 s in: the walk wraps to 0.75 s, the fall stops at its end.
     const auto played = [&](const char* name, std::optional<bool> loop) {
@@ -135,7 +141,7 @@ TEST(DefaultClip, AClipThatGoesSomewherePlaysOnceAndHoldsItsLastPose) {
         o.clip = name;
         o.loop = loop;
         o.start_time_s = 0.5;
-        auto e = spawn_character(registry, asset, *body, o);
+        auto e = spawn_character(registry, asset, body, o);
         EXPECT_TRUE(e) << e.error().message;
         auto& player = registry.get<AnimationPlayer>(*e);
         auto& skeleton = registry.get<Skeleton>(*e);
