@@ -82,8 +82,8 @@ enum class LegFit : std::uint8_t {
     bounding,   ///< One ellipsoid per leg bone bounding its vertices.
 };
 
-/// Trunk shells at most this thin are thickened inward by default (FitOptions::thicken_thin_trunk_m;
-/// chosen on Female_TankTop's, Male_Casual's and Male_LongSleeve's pieces: docs/cloth.md, "Collision").
+/// Trunk shells at most this thin are thickened inward by default (FitOptions::thicken_thin_trunk_m):
+/// the thickness of the pieces the motion suite's torn runs straddled (docs/cloth.md, "Collision").
 inline constexpr double default_thicken_thin_trunk_m = 0.015;
 
 /// How ellipsoids are fitted (the numeric details are ellipsoid_solver.hpp's).
