@@ -63,31 +63,13 @@ std::pair<Matrix3X, Matrix3X> weld(const Matrix3X& positions, std::vector<std::u
 }
 
 // Whether the ray from `o` along `d` first meets the surface from inside, through a face
-// that looks along it (it leaves the body there). Brute force over the faces: it runs only
-// for the few particles the side test finds behind the skin.
-bool leaves_through_surface(const Matrix3X& x, std::span<const std::uint32_t> triangles, const Eigen::Vector3d& o,
-                            const Eigen::Vector3d& d) {
-    double nearest = std::numeric_limits<double>::infinity();
-    bool leaving = false;
-    for (std::size_t f = 0; f + 2 < triangles.size(); f += 3) {
-        const Eigen::Vector3d a = x.col(triangles[f]).cast<double>(), b = x.col(triangles[f + 1]).cast<double>(),
-                              c = x.col(triangles[f + 2]).cast<double>();
-        const Eigen::Vector3d e1 = b - a, e2 = c - a, q = d.cross(e2);
-        const double det = e1.dot(q);
-        if (std::abs(det) < 1e-14) continue;
-        const Eigen::Vector3d s = o - a;
-        const double u = s.dot(q) / det;
-        if (u < 0 || u > 1) continue;
-        const Eigen::Vector3d r = s.cross(e1);
-        const double v = d.dot(r) / det;
-        if (v < 0 || u + v > 1) continue;
-        const double t = e2.dot(r) / det;
-        if (t > 1e-9 && t < nearest) {
-            nearest = t;
-            leaving = e1.cross(e2).dot(d) > 0;
-        }
-    }
-    return leaving;
+// that looks along it (it leaves the body there).
+bool leaves_through_surface(const SkinSurface& surface, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    const SkinSurface::Hit hit = surface.first_hit(o, d);
+    if (hit.triangle < 0) return false;
+    const auto& t = surface.triangle(static_cast<std::size_t>(hit.triangle));
+    const Eigen::Vector3d& a = surface.vertex(t[0]);
+    return (surface.vertex(t[1]) - a).cross(surface.vertex(t[2]) - a).dot(d) > 0;
 }
 
 }  // namespace
@@ -134,7 +116,7 @@ SkinDepths skin_depths(const Registry& registry, const Garment& garment) {
         if (!x.col(p).allFinite()) continue;
         if (garment.state.inv_mass[p] == 0) {
             const SkinSurface::Closest c = surface.closest(x.col(p).cast<double>());
-            const bool behind = c.triangle >= 0 && !c.outside && leaves_through_surface(welded, drawn, x.col(p).cast<double>(), -c.normal);
+            const bool behind = c.triangle >= 0 && !c.outside && leaves_through_surface(surface, x.col(p).cast<double>(), -c.normal);
             out.pins_m.push_back(behind ? -c.distance_m : c.distance_m);
             continue;
         }
@@ -145,7 +127,7 @@ SkinDepths skin_depths(const Registry& registry, const Garment& garment) {
         // shell or turned in at a rim (Male_Casual's shoes: 28 faces) fools the first test
         // alone, by tens of centimetres.
         if (c.triangle >= 0 && !c.outside &&
-            leaves_through_surface(welded, drawn, x.col(p).cast<double>(), -c.normal))
+            leaves_through_surface(surface, x.col(p).cast<double>(), -c.normal))
             out.behind_m.push_back(c.distance_m);
     }
     return out;

@@ -160,6 +160,67 @@ SkinSurface::Closest SkinSurface::closest(const Vector3d& p) const {
     return best;
 }
 
+SkinSurface::Hit SkinSurface::first_hit(const Vector3d& o, const Vector3d& d) const {
+    Hit best;
+    if (m_nodes.empty()) return best;
+    double nearest = std::numeric_limits<double>::infinity();
+    const Vector3d inverse = d.cwiseInverse();  // an axis the ray is parallel to: +-inf
+    // Where the ray is within a box, widened by a little so that rounding never drops a
+    // face the box holds; a box entered past the nearest hit so far is left (one entered
+    // at it may hold a face of lower index met there too).
+    const auto enters_before = [&](const Eigen::AlignedBox3d& box) {
+        double near = 0, far = nearest;
+        for (int i = 0; i < 3; ++i) {
+            const double slack = 1e-9 + 1e-9 * (std::abs(box.min()[i]) + std::abs(box.max()[i]));
+            const double lo = box.min()[i] - slack, hi = box.max()[i] + slack;
+            if (d[i] == 0) {
+                if (o[i] < lo || o[i] > hi) return false;
+                continue;
+            }
+            double t0 = (lo - o[i]) * inverse[i], t1 = (hi - o[i]) * inverse[i];
+            if (t0 > t1) std::swap(t0, t1);
+            near = std::max(near, t0);
+            far = std::min(far, t1);
+            if (near > far) return false;
+        }
+        return true;
+    };
+    std::uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const std::uint32_t index = stack[--top];
+        const Node& node = m_nodes[index];
+        if (!enters_before(node.box)) continue;
+        if (node.count == 0) {
+            if (top + 2 > 64) continue;  // deeper than any balanced tree of 2^60 faces
+            stack[top++] = node.first;
+            stack[top++] = index + 1;
+            continue;
+        }
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+            const auto& tri = m_triangles[m_order[i]];
+            const Vector3d &a = m_positions[tri[0]], &b = m_positions[tri[1]], &c = m_positions[tri[2]];
+            const Vector3d e1 = b - a, e2 = c - a, q = d.cross(e2);
+            const double det = e1.dot(q);
+            if (std::abs(det) < 1e-14) continue;
+            const Vector3d s = o - a;
+            const double u = s.dot(q) / det;
+            if (u < 0 || u > 1) continue;
+            const Vector3d r = s.cross(e1);
+            const double v = d.dot(r) / det;
+            if (v < 0 || u + v > 1) continue;
+            const double t = e2.dot(r) / det;
+            if (t > 1e-9 && (t < nearest || (t == nearest && m_order[i] < best.triangle))) {
+                nearest = t;
+                best.t = t;
+                best.triangle = m_order[i];
+            }
+        }
+    }
+    return best;
+}
+
 std::vector<SkinSample> sample_skin(const Matrix3X& positions, const Matrix3X& normals, std::span<const std::uint32_t> indices,
                                     double spacing_m) {
     std::vector<SkinSample> out;

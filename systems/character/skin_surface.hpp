@@ -37,6 +37,14 @@ public:
     };
     [[nodiscard]] Closest closest(const Eigen::Vector3d& point) const;
 
+    /// The first face a ray meets: the smallest `t` > 1e-9 with `origin + t direction` on a
+    /// face (Moller-Trumbore; of faces met at the same `t`, the lowest index).
+    struct Hit {
+        double t = 0;
+        std::int64_t triangle = -1;  ///< -1: the ray meets no face.
+    };
+    [[nodiscard]] Hit first_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+
     [[nodiscard]] std::size_t triangle_count() const noexcept { return m_triangles.size(); }
     /// Total area of the faces, m^2.
     [[nodiscard]] double area_m2() const noexcept { return m_area_m2; }
