@@ -447,7 +447,7 @@ TEST(SpringPlaceTest, TheWorstSpringIsPlacedOnTheGarmentAndTheBody) {
 
 // With thin_trunk_piece_m a built garment leaves out of its collision the trunk's pieces at
 // most that thin, and only those: a torso piece 1 cm thin in front of the pelvis is among the
-// skirt's colliders by default and at 5 mm, and not at 1.5 cm; the anchor is another piece.
+// skirt's colliders at 0 and at 5 mm, and not at 1.5 cm (the default); the anchor is another piece.
 TEST(GarmentBuilder, ThinTrunkPiecesAreLeftOutOfTheCollisionWithTheOption) {
     for (const Real thin : {Real(0), Real(0.005), Real(0.015)}) {
         SCOPED_TRACE("thin_trunk_piece_m " + std::to_string(thin));
