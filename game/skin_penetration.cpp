@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
-#include <span>
 #include <unordered_map>
 #include <utility>
 
@@ -127,8 +125,10 @@ SkinDepths skin_depths(const Registry& registry, const Garment& garment) {
         // shell or turned in at a rim (Male_Casual's shoes: 28 faces) fools the first test
         // alone, by tens of centimetres.
         if (c.triangle >= 0 && !c.outside &&
-            leaves_through_surface(surface, x.col(p).cast<double>(), -c.normal))
+            leaves_through_surface(surface, x.col(p).cast<double>(), -c.normal)) {
             out.behind_m.push_back(c.distance_m);
+            out.behind_particles.push_back(static_cast<std::uint32_t>(p));
+        }
     }
     return out;
 }

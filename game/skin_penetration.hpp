@@ -21,6 +21,7 @@ namespace drape {
 /// One garment after one frame.
 struct SkinDepths {
     std::vector<double> behind_m;  ///< Depth of each free particle behind the skin, m.
+    std::vector<std::uint32_t> behind_particles;  ///< Which particle each of behind_m is (its column in GarmentState::x).
     std::uint64_t free = 0;        ///< Free particles measured.
     std::vector<double> pins_m;    ///< Each pinned particle's distance from the skin, m: > 0 outside, < 0 behind it.
     bool measured = false;         ///< False: the character has no skinned mesh or skeleton.
