@@ -159,15 +159,14 @@ void dress_and_walk(const Character& c, GarmentType type) {
 // 300 frames of the walk the importer picks, after every frame: strain p99 <= 10 %, max
 // <= 20 %, nothing inside after the frame beyond 2 mm (past a forearm's or a hand's give),
 // pins outside. Measured (worst spring, the build scripts/test makes: x86-64-v3, Eigen's
-// exact square root, the same bits on Intel and AMD): Male_Casual's skirt and dress 10.0 %;
-// RobotExpressive's skirt (54 lines round its waist, line_spacing_m) and dress (shortened
-// to clear its feet, settled from its first pose by contact repair) 10.0 %;
-// Female_Alternative's skirt 14.4 %. These walks are chaotic where the cloth is caught:
-// started from 25 points of their clips, Female_Alternative's skirt went over 20 % from 1,
-// Male_Casual's dress from 1, the others from none (docs/cloth.md "Reproducibility"; her
-// skirt reached 125 % on an Intel Xeon in a build whose square root the CPU approximated).
-// Female_Alternative's dress 13.0 % (over 20 % from 3 of the 25 starts; its shortest spring
-// 2.7 % of its rest length, which this contract does not ask about).
+// exact square root, the same bits on Intel and AMD): all six 10.0 %, RobotExpressive's
+// skirt with 54 lines round its waist (line_spacing_m) and its dress shortened to clear its
+// feet; with the trunk's thin pieces collided (thin_trunk_piece_m 0), Female_Alternative's
+// skirt 14.4 % and dress 13.0 %. These walks are chaotic where the cloth is caught: with the
+// thin pieces collided and started from 25 points of their clips, Female_Alternative's
+// skirt went over 20 % from 1, her dress from 3, Male_Casual's dress from 1, the others from
+// none (docs/cloth.md "Reproducibility"; her skirt reached 125 % on an Intel Xeon in a build
+// whose square root the CPU approximated).
 TEST(DressAnyCharacter, GarmentsHoldTheContractOnTheSharedHumanoids) {
     const Character female{"characters/female_alternative/Female_Alternative.fbx", ""};
     const std::pair<const Character&, GarmentType> cases[] = {{characters[0], GarmentType::skirt},
