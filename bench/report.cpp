@@ -98,6 +98,9 @@ Machine describe_machine() {
 #ifdef __AVX2__
     m.build += ", AVX2";
 #endif
+#ifdef __AVX512F__
+    m.build += ", AVX-512";  // the same source runs its chaotic cases elsewhere on such a build (docs/cloth.md "Reproducibility")
+#endif
 #ifdef DRAPE_BENCH_SOURCE_DIR
     m.source_commit = command_output("git -C '" DRAPE_BENCH_SOURCE_DIR "' rev-parse --short HEAD 2>/dev/null");
 #endif
