@@ -84,6 +84,8 @@ enum class LegFit : std::uint8_t {
 
 /// Trunk shells at most this thin are thickened inward by default (FitOptions::thicken_thin_trunk_m):
 /// the thickness of the pieces the motion suite's torn runs straddled (docs/cloth.md, "Collision").
+/// Built-in garments leave the trunk's pieces still this thin out of their collision
+/// (TubeParams::thin_trunk_piece_m).
 inline constexpr double default_thicken_thin_trunk_m = 0.015;
 
 /// How ellipsoids are fitted (the numeric details are ellipsoid_solver.hpp's).

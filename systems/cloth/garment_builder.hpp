@@ -31,6 +31,7 @@
 #include "drape/components/garment.hpp"
 #include "drape/engine/core/error.hpp"
 #include "drape/engine/core/registry.hpp"
+#include "drape/systems/character/ellipsoid_fit.hpp"
 
 namespace drape {
 
@@ -76,8 +77,10 @@ struct TubeParams {
     Real inertia_max_fall_m_s2 = InertiaScales{}.max_fall_m_s2;      ///< InertiaScales::max_fall_m_s2: free fall (0: no bound).
     Real max_distance_share = 0;      ///< GarmentConfig::max_distance_share (0: none).
     int max_distance_on_skin = 0;     ///< 1: GarmentConfig::max_distance_on_skin (the spheres follow the skin of trunk and legs).
-    Real thin_trunk_piece_m = Real(0.015);  ///< > 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is
-                                            ///< at most this (the anchor's apart); 0: with every ellipsoid (docs/cloth.md "Thin trunk pieces").
+    /// > 0: no collision with the torso's and pelvis's ellipsoids whose smallest radius is at most this (the
+    /// anchor's apart): by default the pieces the body fit leaves that thin (FitOptions::thicken_thin_trunk_m);
+    /// 0: with every ellipsoid (docs/cloth.md "Thin trunk pieces").
+    Real thin_trunk_piece_m = Real(default_thicken_thin_trunk_m);
     PinWeights pin_weights = PinWeights::nearest_vertex;  ///< How the skinned pins are bound.
     ClothMaterial material{};
     ClothModel model = ClothModel::simplified;

@@ -48,7 +48,7 @@ const Character characters[] = {
 struct Inside {
     int collided = 0;     ///< Inside an ellipsoid the garment collides with.
     int upper_arms = 0;   ///< Inside only upper-arm ellipsoids it does not collide with.
-    std::vector<std::uint32_t> trunk;  ///< Inside only torso or pelvis ellipsoids it does not collide with.
+    std::vector<std::uint32_t> trunk;  ///< Inside only torso or pelvis ellipsoids it does not collide with (ascending).
     int other = 0;        ///< Inside only other ellipsoids it does not collide with.
 };
 
@@ -129,7 +129,7 @@ void dress_and_walk(const Character& c, GarmentType type) {
     ASSERT_TRUE(skin.measured);
     double in_trunk_m = 0, elsewhere_m = 0;
     for (std::size_t k = 0; k < skin.behind_m.size(); ++k) {
-        const bool in_piece = std::find(inside.trunk.begin(), inside.trunk.end(), skin.behind_particles[k]) != inside.trunk.end();
+        const bool in_piece = std::binary_search(inside.trunk.begin(), inside.trunk.end(), skin.behind_particles[k]);
         double& deepest = in_piece ? in_trunk_m : elsewhere_m;
         deepest = std::max(deepest, skin.behind_m[k]);
     }
